@@ -1,0 +1,64 @@
+// `thaw bench`: throughput per stage against a hand-written reference loop, and accuracy sweeps.
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "bench/accuracy.h"
+#include "bench/throughput.h"
+#include "server/cli_args.h"
+#include "server/commands.h"
+#include "sim/error.h"
+
+namespace thaw {
+namespace {
+
+template <class T>
+std::vector<T> list_of(const std::string& text, const char* option) {
+  std::vector<T> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (end == item.c_str() || *end != '\0' || v <= 0) throw Error(std::string(option) + ": bad item '" + item + "'");
+    out.push_back(static_cast<T>(v));
+  }
+  if (out.empty()) throw Error(std::string(option) + ": empty list");
+  return out;
+}
+
+}  // namespace
+
+int cmd_bench(int argc, char** argv) {
+  if (argc < 3) throw Error("bench needs a kind: throughput or accuracy");
+  const std::string kind = argv[2];
+  if (kind == "throughput") {
+    CliArgs args(argc, argv, 3, {"--sizes", "--steps", "--device"}, {"--json"});
+    ThroughputOptions o;
+    if (auto s = args.value("--sizes")) o.sizes = list_of<std::size_t>(*s, "--sizes");
+    o.steps = static_cast<int>(args.integer("--steps", o.steps));
+    if (o.steps < 1) throw Error("--steps: must be >= 1");
+    ClRuntime cl(args.value("--device").value_or(""));
+    const Json r = bench_throughput(cl, o, !args.flag("--json"));
+    if (args.flag("--json")) std::printf("%s\n", r.dump(2).c_str());
+    return 0;
+  }
+  if (kind == "accuracy") {
+    CliArgs args(argc, argv, 3, {"--res", "--out", "--device"}, {"--json"});
+    if (args.positional().size() != 1) throw Error("bench accuracy needs one CASE (see thaw validate --list)");
+    AccuracyOptions o;
+    o.case_name = args.positional()[0];
+    if (auto r = args.value("--res")) o.resolutions = list_of<int>(*r, "--res");
+    o.out_dir = args.value("--out").value_or("bench-results");
+    o.overrides = args.sets();
+    ClRuntime cl(args.value("--device").value_or(""));
+    const Json r = bench_accuracy(cl, o, !args.flag("--json"));
+    if (args.flag("--json")) std::printf("%s\n", r.dump(2).c_str());
+    return 0;
+  }
+  throw Error("unknown bench '" + kind + "' (throughput, accuracy)");
+}
+
+}  // namespace thaw

@@ -1,0 +1,157 @@
+// `thaw run`: a headless run of a scene, with metrics, particle exports and state files.
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+
+#include "server/cli_args.h"
+#include "server/commands.h"
+#include "server/progress.h"
+#include "sim/error.h"
+#include "sim/metrics.h"
+#include "sim/particle_export.h"
+#include "sim/solver.h"
+#include "sim/state_file.h"
+
+namespace thaw {
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+Json stage_ms(const StageTimers& t, std::uint64_t steps) {
+  Json j;
+  for (int s = 0; s < static_cast<int>(Stage::Count); ++s)
+    j[kStageNames[s]] = steps ? 1e3 * t.seconds(static_cast<Stage>(s)) / double(steps) : 0.0;
+  return j;
+}
+
+}  // namespace
+
+int cmd_run(int argc, char** argv) {
+  CliArgs args(argc, argv, 2,
+               {"--until", "--steps", "--metrics", "--export", "--every", "--state-out", "--state-in", "--device"},
+               {"--quiet", "--no-progress"});
+  if (args.positional().size() > 1) throw Error("run takes one scene, got " + std::to_string(args.positional().size()));
+  const bool has_scene = !args.positional().empty();
+  const auto state_in = args.value("--state-in");
+  if (!has_scene && !state_in) throw Error("run needs a SCENE (a name in configs/ or a file), or --state-in FILE");
+  if (!args.value("--until") && !args.value("--steps")) throw Error("run needs --until SECONDS or --steps N");
+  if (args.value("--until") && args.value("--steps")) throw Error("give either --until or --steps, not both");
+
+  Scene scene;
+  SimState start;
+  if (state_in) {
+    start = read_state_file(*state_in);
+    if (has_scene) {
+      scene = load_scene(args.positional()[0], args.sets());
+      if (scene.source.dump() != start.scene_json)
+        std::fprintf(stderr, "note: scene differs from the one stored in %s; continuing with %s\n", state_in->c_str(),
+                     args.positional()[0].c_str());
+    } else {
+      scene = scene_from_json(Json::parse(start.scene_json), args.sets());
+    }
+  } else {
+    scene = load_scene(args.positional()[0], args.sets());
+    start = initial_state(scene);
+  }
+
+  const double until = args.number("--until", 0.0);
+  const long long steps_wanted = args.integer("--steps", 0);
+  if (args.value("--steps") && steps_wanted < 0) throw Error("--steps: must be >= 0");
+  const long long every = args.integer("--every", 10);
+  if (every < 1) throw Error("--every: must be >= 1");
+  const bool quiet = args.flag("--quiet");
+
+  ClRuntime cl(args.value("--device").value_or(""));
+  Solver solver(cl, scene, start);
+  solver.warm_up();
+  solver.timers().reset();
+
+  std::unique_ptr<std::ofstream> metrics;
+  if (auto f = args.value("--metrics")) {
+    metrics = std::make_unique<std::ofstream>(*f);
+    if (!*metrics) throw Error("cannot write metrics file " + *f);
+  }
+  std::unique_ptr<ParticleExporter> exporter;
+  if (auto d = args.value("--export")) exporter = std::make_unique<ParticleExporter>(*d);
+
+  const auto counts = solver.particles();
+  if (!quiet)
+    std::printf("thaw run: scene '%s', %zu particles (water %zu, solid %zu) on %s\n", scene.name.c_str(),
+                solver.size(), counts.count(Phase::Water), counts.count(Phase::Solid), cl.description().c_str());
+  std::fflush(stdout);
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  const std::uint64_t first_step = solver.steps();
+  const std::uint64_t last_step = first_step + static_cast<std::uint64_t>(std::max(0LL, steps_wanted));
+  const bool by_time = args.value("--until").has_value();
+  auto done = [&] { return by_time ? solver.time() >= until : solver.steps() >= last_step; };
+  Progress progress(by_time ? until : double(last_step), by_time ? "s" : "steps", !quiet && !args.flag("--no-progress"));
+
+  const double interval = scene.solver.output_interval;
+  double next_output = (std::floor(solver.time() / interval + 1e-9) + 1.0) * interval;
+  std::uint64_t interval_steps = 0;
+  auto interval_start = Clock::now();
+  StageTimers interval_timers;
+  auto write_metrics = [&] {
+    if (!metrics) return;
+    const double wall_ms = interval_steps ? 1e3 * seconds_since(interval_start) / double(interval_steps) : 0.0;
+    StageTimers diff;
+    for (int s = 0; s < static_cast<int>(Stage::Count); ++s)
+      diff.add(static_cast<Stage>(s), solver.timers().seconds(static_cast<Stage>(s)) - interval_timers.seconds(static_cast<Stage>(s)));
+    *metrics << metrics_json(measure(solver), wall_ms, stage_ms(diff, interval_steps)).dump() << '\n';
+    metrics->flush();
+    interval_steps = 0;
+    interval_start = Clock::now();
+    interval_timers = solver.timers();
+  };
+  write_metrics();
+  if (exporter) exporter->write(solver.particles(), solver.time());
+
+  const auto t0 = Clock::now();
+  while (!done() && !g_stop) {
+    solver.step();
+    ++interval_steps;
+    if (exporter && (solver.steps() - first_step) % std::uint64_t(every) == 0)
+      exporter->write(solver.particles(), solver.time());
+    if (solver.time() >= next_output - 1e-12) {
+      write_metrics();
+      next_output = (std::floor(solver.time() / interval + 1e-9) + 1.0) * interval;
+    }
+    progress.update(by_time ? solver.time() : double(solver.steps()), solver.steps() - first_step);
+  }
+  const double wall = seconds_since(t0);
+  progress.finish();
+  if (interval_steps) write_metrics();
+  if (g_stop) std::fprintf(stderr, "thaw run: interrupted at step %llu; finishing outputs\n", (unsigned long long)solver.steps());
+  if (auto f = args.value("--state-out")) write_state_file(*f, solver.state());
+
+  if (!quiet) {
+    const auto m = measure(solver);
+    const std::uint64_t steps = solver.steps() - first_step;
+    const double sim = solver.time() - start.time;
+    std::printf("steps %llu, sim time %.6g s -> %.6g s, wall %.3f s", (unsigned long long)steps, start.time,
+                solver.time(), wall);
+    if (steps) {
+      std::printf(" (%.3g wall s per sim s; %.3f wall us per particle-step)\n", sim > 0 ? wall / sim : 0.0,
+                  1e6 * wall / double(steps) / double(std::max<std::size_t>(solver.size(), 1)));
+      std::printf("stages, ms per step:");
+      const auto& t = solver.timers();
+      for (int s = 0; s < static_cast<int>(Stage::Count); ++s)
+        std::printf("  %s %.3f (%.0f%%)", kStageNames[s], 1e3 * t.seconds(static_cast<Stage>(s)) / double(steps),
+                    100.0 * t.seconds(static_cast<Stage>(s)) / std::max(t.total(), 1e-12));
+    }
+    std::printf("\nfinal: dt %.3g s, max speed %.4g m/s, density error max %.3g %% mean %.3g %%, fluid mass %.9g kg, "
+                "clamped %llu, kinetic %.4g J\n",
+                m.dt, m.max_speed, 100 * m.max_density_error, 100 * m.mean_density_error, m.fluid_mass,
+                (unsigned long long)m.clamped, m.kinetic);
+  }
+  return g_stop ? 130 : 0;
+}
+
+}  // namespace thaw

@@ -1,0 +1,58 @@
+// thaw: SPH ice-melting simulation. One executable, one subcommand per job.
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "server/commands.h"
+#include "sim/cl_runtime.h"
+#include "sim/error.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: thaw <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  run SCENE        headless run: --until S | --steps N, --set PATH=VALUE, --metrics FILE.jsonl,\n"
+    "                   --export DIR --every K, --state-out FILE, --state-in FILE, --device D\n"
+    "  validate CASE    a validation case against its reference: --res R, --set, --json; --list\n"
+    "  bench throughput µs per particle-step per stage, with a hand-written reference loop (--json)\n"
+    "  bench accuracy CASE  error against run time over resolutions (--res 10,15,20 --out DIR)\n"
+    "  info             OpenCL platforms and devices, and the one that would be used\n"
+    "  scene-doc        the scene file reference (docs/SCENES.md)\n"
+    "\n"
+    "Scenes are JSON files in configs/ (see docs/SCENES.md); --device or THAW_DEVICE picks the OpenCL\n"
+    "device: gpu, cpu, P:D, or part of its name.\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "help")) {
+    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string cmd = argv[1];
+  try {
+    if (cmd == "run") return thaw::cmd_run(argc, argv);
+    if (cmd == "validate") return thaw::cmd_validate(argc, argv);
+    if (cmd == "bench") return thaw::cmd_bench(argc, argv);
+    if (cmd == "info") return thaw::cmd_info(argc, argv);
+    if (cmd == "scene-doc") return thaw::cmd_scene_doc(argc, argv);
+    std::fprintf(stderr, "thaw: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
+    return 2;
+  } catch (const thaw::BlowUpError& e) {
+    std::fprintf(stderr, "thaw %s: simulation stopped: %s\n", cmd.c_str(), e.what());
+    return 3;
+  } catch (const thaw::Error& e) {
+    std::fprintf(stderr, "thaw %s: %s\n", cmd.c_str(), e.what());
+    return 2;
+  } catch (const cl::Error& e) {
+    std::fprintf(stderr, "thaw %s: OpenCL error in %s: %s (%d)\n", cmd.c_str(), e.what(),
+                 thaw::cl_error_name(e.err()), e.err());
+    return 4;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "thaw %s: %s\n", cmd.c_str(), e.what());
+    return 4;
+  }
+}

@@ -1,0 +1,201 @@
+#include "sim/cl_runtime.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <sstream>
+
+#include "sim/embedded_kernels.h"
+#include "sim/error.h"
+
+namespace thaw {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+std::string type_name(cl_device_type t) {
+  if (t & CL_DEVICE_TYPE_GPU) return "GPU";
+  if (t & CL_DEVICE_TYPE_CPU) return "CPU";
+  if (t & CL_DEVICE_TYPE_ACCELERATOR) return "accelerator";
+  return "other";
+}
+
+std::vector<cl::Platform> platforms() {
+  std::vector<cl::Platform> ps;
+  cl_uint count = 0;
+  // clGetPlatformIDs returns CL_PLATFORM_NOT_FOUND_KHR when the ICD loader finds nothing.
+  if (clGetPlatformIDs(0, nullptr, &count) != CL_SUCCESS || count == 0) return ps;
+  cl::Platform::get(&ps);
+  return ps;
+}
+
+cl::Device device_at(const DeviceInfo& d) {
+  std::vector<cl::Device> devs;
+  platforms().at(static_cast<std::size_t>(d.platform)).getDevices(CL_DEVICE_TYPE_ALL, &devs);
+  return devs.at(static_cast<std::size_t>(d.device));
+}
+
+std::string describe_all(const std::vector<DeviceInfo>& all) {
+  if (all.empty()) return "no OpenCL devices at all";
+  std::ostringstream os;
+  for (const auto& d : all) os << "\n  " << d.platform << ":" << d.device << "  " << d.type << "  " << d.name;
+  return os.str();
+}
+
+}  // namespace
+
+std::vector<DeviceInfo> list_devices() {
+  std::vector<DeviceInfo> out;
+  const auto ps = platforms();
+  for (std::size_t p = 0; p < ps.size(); ++p) {
+    std::vector<cl::Device> devs;
+    try {
+      ps[p].getDevices(CL_DEVICE_TYPE_ALL, &devs);
+    } catch (const cl::Error&) {
+      continue;  // a platform with no devices
+    }
+    for (std::size_t i = 0; i < devs.size(); ++i) {
+      DeviceInfo d;
+      d.platform = static_cast<int>(p);
+      d.device = static_cast<int>(i);
+      d.platform_name = ps[p].getInfo<CL_PLATFORM_NAME>();
+      d.name = devs[i].getInfo<CL_DEVICE_NAME>();
+      d.type = type_name(devs[i].getInfo<CL_DEVICE_TYPE>());
+      d.version = devs[i].getInfo<CL_DEVICE_VERSION>();
+      d.compute_units = devs[i].getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+      d.global_memory = devs[i].getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+      out.push_back(d);
+    }
+  }
+  return out;
+}
+
+DeviceInfo choose_device(const std::string& requested) {
+  std::string spec = requested;
+  if (spec.empty()) {
+    if (const char* env = std::getenv("THAW_DEVICE")) spec = env;
+  }
+  const auto all = list_devices();
+  if (all.empty())
+    throw Error(
+        "no OpenCL platform or device found: the ICD loader (libOpenCL) found no driver in "
+        "/etc/OpenCL/vendors (install pocl-opencl-icd for the CPU, or a GPU vendor's driver)");
+  const std::string s = lower(spec);
+  auto first_of = [&](const std::string& type) -> const DeviceInfo* {
+    for (const auto& d : all)
+      if (d.type == type) return &d;
+    return nullptr;
+  };
+  if (s.empty()) {
+    if (auto* d = first_of("GPU")) return *d;
+    if (auto* d = first_of("CPU")) return *d;
+    return all.front();
+  }
+  if (s == "gpu" || s == "cpu") {
+    if (auto* d = first_of(s == "gpu" ? "GPU" : "CPU")) return *d;
+    throw Error("no OpenCL " + s + " device found (--device / THAW_DEVICE='" + spec +
+                "'); devices present:" + describe_all(all));
+  }
+  if (auto colon = s.find(':'); colon != std::string::npos && std::isdigit((unsigned char)s[0])) {
+    const int p = std::atoi(s.substr(0, colon).c_str());
+    const int i = std::atoi(s.substr(colon + 1).c_str());
+    for (const auto& d : all)
+      if (d.platform == p && d.device == i) return d;
+    throw Error("no OpenCL device " + spec + " (platform:device); devices present:" + describe_all(all));
+  }
+  for (const auto& d : all)
+    if (lower(d.name).find(s) != std::string::npos) return d;
+  throw Error(
+      "no OpenCL device whose name contains '" + spec +
+      "' (--device / THAW_DEVICE; also accepted: gpu, cpu, P:D); devices present:" + describe_all(all));
+}
+
+ClRuntime::ClRuntime(const std::string& device_spec) : info_(choose_device(device_spec)) {
+  device_ = device_at(info_);
+  context_ = cl::Context(device_);
+  queue_ = cl::CommandQueue(context_, device_);
+}
+
+std::string ClRuntime::description() const {
+  std::ostringstream os;
+  os << info_.name << " (" << info_.type << ", " << info_.platform_name << ", " << info_.compute_units
+     << " compute units)";
+  return os.str();
+}
+
+cl::Program ClRuntime::build(const std::vector<std::string>& files, const std::string& options) const {
+  const auto& embedded = embedded_kernel_files();
+  std::string source;
+  std::string names;
+  for (const auto& f : files) {
+    auto it = embedded.find(f);
+    if (it == embedded.end()) throw Error("kernel file sim/kernels/" + f + " is not embedded in this build");
+    source += "#line 1 \"sim/kernels/" + f + "\"\n";
+    source += it->second;
+    source += "\n";
+    names += (names.empty() ? "" : ", ") + std::string("sim/kernels/") + f;
+  }
+  cl::Program program(context_, source);
+  const std::string opts = "-cl-std=CL1.2 -cl-mad-enable " + options;
+  cl_int status = CL_SUCCESS;
+  try {
+    program.build({device_}, opts.c_str());
+  } catch (const cl::BuildError& e) {
+    status = e.err();
+  } catch (const cl::Error& e) {
+    status = e.err();
+  }
+  if (status != CL_SUCCESS) {
+    std::string log;
+    try {
+      log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
+    } catch (const cl::Error&) {
+      log = "(no build log)";
+    }
+    throw Error("OpenCL build of " + names + " failed on " + info_.name + " (" + cl_error_name(status) +
+                ", options '" + opts + "'):\n" + log);
+  }
+  return program;
+}
+
+const char* cl_error_name(cl_int code) {
+  switch (code) {
+#define THAW_CASE(x) \
+  case x:            \
+    return #x;
+    THAW_CASE(CL_SUCCESS)
+    THAW_CASE(CL_DEVICE_NOT_FOUND)
+    THAW_CASE(CL_DEVICE_NOT_AVAILABLE)
+    THAW_CASE(CL_COMPILER_NOT_AVAILABLE)
+    THAW_CASE(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    THAW_CASE(CL_OUT_OF_RESOURCES)
+    THAW_CASE(CL_OUT_OF_HOST_MEMORY)
+    THAW_CASE(CL_BUILD_PROGRAM_FAILURE)
+    THAW_CASE(CL_INVALID_VALUE)
+    THAW_CASE(CL_INVALID_DEVICE)
+    THAW_CASE(CL_INVALID_CONTEXT)
+    THAW_CASE(CL_INVALID_COMMAND_QUEUE)
+    THAW_CASE(CL_INVALID_MEM_OBJECT)
+    THAW_CASE(CL_INVALID_BUILD_OPTIONS)
+    THAW_CASE(CL_INVALID_PROGRAM)
+    THAW_CASE(CL_INVALID_PROGRAM_EXECUTABLE)
+    THAW_CASE(CL_INVALID_KERNEL_NAME)
+    THAW_CASE(CL_INVALID_KERNEL)
+    THAW_CASE(CL_INVALID_ARG_INDEX)
+    THAW_CASE(CL_INVALID_ARG_VALUE)
+    THAW_CASE(CL_INVALID_ARG_SIZE)
+    THAW_CASE(CL_INVALID_KERNEL_ARGS)
+    THAW_CASE(CL_INVALID_WORK_GROUP_SIZE)
+    THAW_CASE(CL_INVALID_WORK_ITEM_SIZE)
+    THAW_CASE(CL_INVALID_GLOBAL_WORK_SIZE)
+    THAW_CASE(CL_INVALID_BUFFER_SIZE)
+#undef THAW_CASE
+    default:
+      return "CL error";
+  }
+}
+
+}  // namespace thaw

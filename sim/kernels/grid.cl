@@ -1,0 +1,99 @@
+/* Neighbour grid: cell keys (with domain clamping), a stable radix sort of the keys, a gather of
+ * every per-particle buffer into sorted order, and the start of each cell's range. */
+
+/* Key of each particle's cell; fluid particles outside the domain are put back on its face, their
+ * outward velocity removed, and counted (never silently lost). */
+kernel void cell_keys(global float4* pos, global float4* vel, global const uchar* phase, global uint* keys,
+                      global uint* order, volatile global uint* clamped, const Grid g, const float4 dmin,
+                      const float4 dmax, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  float4 p = pos[i];
+  if (phase[i] != THAW_PHASE_SOLID) {
+    const int4 below = isless(p, dmin);
+    const int4 above = isgreater(p, dmax);
+    if (any(below.xyz) || any(above.xyz)) {
+      float4 v = vel[i];
+      v = select(v, fmax(v, 0.0f), below);
+      v = select(v, fmin(v, 0.0f), above);
+      vel[i] = (float4)(v.xyz, 0.0f);
+      pos[i] = (float4)(clamp(p.xyz, dmin.xyz, dmax.xyz), p.w);
+      p = pos[i];
+      atomic_inc(clamped);
+    }
+  }
+  keys[i] = grid_key(g, grid_cell(g, p));
+  order[i] = i;
+}
+
+/* Radix sort, 8 bits a pass. Each work-item owns one tile of consecutive particles and walks it in
+ * order, so the sort is stable and deterministic without atomics (rank-based scatter). */
+kernel void radix_histogram(global const uint* keys, global uint* hist, const uint shift, const uint n,
+                            const uint tile, const uint ntiles) {
+  const uint t = get_global_id(0);
+  if (t >= ntiles) return;
+  for (uint d = 0; d < 256; ++d) hist[d * ntiles + t] = 0;
+  const uint e = min(n, (t + 1) * tile);
+  for (uint i = t * tile; i < e; ++i) hist[((keys[i] >> shift) & 255u) * ntiles + t] += 1;
+}
+
+/* Exclusive scan of each digit's row of tile counts; the row total goes to totals[d]. */
+kernel void radix_scan_rows(global uint* hist, global uint* totals, const uint ntiles) {
+  const uint d = get_global_id(0);
+  if (d >= 256) return;
+  uint sum = 0;
+  for (uint t = 0; t < ntiles; ++t) {
+    const uint c = hist[d * ntiles + t];
+    hist[d * ntiles + t] = sum;
+    sum += c;
+  }
+  totals[d] = sum;
+}
+
+kernel void radix_scatter(global const uint* keys_in, global const uint* vals_in, global uint* keys_out,
+                          global uint* vals_out, global uint* hist, global const uint* totals,
+                          const uint shift, const uint n, const uint tile, const uint ntiles) {
+  const uint t = get_global_id(0);
+  if (t >= ntiles) return;
+  uint base[256];
+  uint sum = 0;
+  for (uint d = 0; d < 256; ++d) {
+    base[d] = sum + hist[d * ntiles + t];
+    sum += totals[d];
+  }
+  const uint e = min(n, (t + 1) * tile);
+  for (uint i = t * tile; i < e; ++i) {
+    const uint k = keys_in[i];
+    const uint d = (k >> shift) & 255u;
+    const uint dst = base[d]++;
+    keys_out[dst] = k;
+    vals_out[dst] = vals_in[i];
+  }
+}
+
+/* cell_start[k] = first sorted particle with key >= k; every entry written exactly once. */
+kernel void cell_starts(global const uint* keys, global uint* cell_start, const uint n, const uint ncells) {
+  const uint i = get_global_id(0);
+  if (i > n) return;
+  const uint lo = i == 0 ? 0u : keys[i - 1] + 1u;
+  const uint hi = i == n ? ncells : keys[i];
+  for (uint k = lo; k <= hi; ++k) cell_start[k] = i;
+}
+
+/* Gathers of one per-particle buffer into sorted order, one per element type. */
+kernel void gather_float4(global const uint* order, global const float4* in, global float4* out, const uint n) {
+  const uint i = get_global_id(0);
+  if (i < n) out[i] = in[order[i]];
+}
+kernel void gather_float(global const uint* order, global const float* in, global float* out, const uint n) {
+  const uint i = get_global_id(0);
+  if (i < n) out[i] = in[order[i]];
+}
+kernel void gather_uint(global const uint* order, global const uint* in, global uint* out, const uint n) {
+  const uint i = get_global_id(0);
+  if (i < n) out[i] = in[order[i]];
+}
+kernel void gather_uchar(global const uint* order, global const uchar* in, global uchar* out, const uint n) {
+  const uint i = get_global_id(0);
+  if (i < n) out[i] = in[order[i]];
+}

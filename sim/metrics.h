@@ -1,0 +1,29 @@
+#pragma once
+// What a run reports per output interval (`--metrics FILE.jsonl`): conserved sums in double.
+#include "sim/particles.h"
+#include "sim/scene.h"
+
+namespace thaw {
+
+class Solver;
+
+struct Metrics {
+  double time = 0, dt = 0;
+  std::uint64_t steps = 0;
+  std::uint64_t clamped = 0;
+  std::size_t count[kPhaseCount] = {};
+  double max_speed = 0;          // over moving particles [m/s]
+  double max_density_error = 0;  // max (rho - rho0) / rho0 over fluid particles (compression)
+  double mean_density_error = 0;
+  double fluid_mass = 0;         // [kg], summed in double
+  double kinetic = 0;            // [J]
+  double potential = 0;          // [J], -sum m g.x
+};
+
+Metrics measure(const HostParticles& p, const Scene& scene, double rest_density);
+Metrics measure(const Solver& solver);
+
+// One JSON line: the metrics plus the wall-clock figures of the interval.
+Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_ms_per_step);
+
+}  // namespace thaw

@@ -1,0 +1,30 @@
+#include "sim/particles.h"
+
+#include <algorithm>
+
+namespace thaw {
+
+const char* phase_name(Phase p) {
+  switch (p) {
+    case Phase::Water: return "water";
+    case Phase::Ice: return "ice";
+    case Phase::Solid: return "solid";
+    case Phase::Air: return "air";
+  }
+  return "unknown";
+}
+
+void HostParticles::resize(std::size_t n) {
+  position.resize(n);
+  velocity.resize(n);
+  density.resize(n);
+  phase.resize(n);
+  material.resize(n);
+  id.resize(n);
+}
+
+std::size_t HostParticles::count(Phase p) const {
+  return static_cast<std::size_t>(std::count(phase.begin(), phase.end(), static_cast<std::uint8_t>(p)));
+}
+
+}  // namespace thaw

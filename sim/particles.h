@@ -1,0 +1,28 @@
+#pragma once
+// Host copy of the per-particle state, structure of arrays, in the device's current (sorted) order.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace thaw {
+
+enum class Phase : std::uint8_t { Water = 0, Ice = 1, Solid = 2, Air = 3 };
+inline constexpr int kPhaseCount = 4;
+const char* phase_name(Phase p);
+
+using Float4 = std::array<float, 4>;  // layout-compatible with cl_float4
+
+struct HostParticles {
+  std::vector<Float4> position;        // x, y, z [m]; w = mass [kg] (static solids: rho0 * Psi, Akinci 2012)
+  std::vector<Float4> velocity;        // x, y, z [m/s]; w unused (0)
+  std::vector<float> density;          // [kg/m^3], from the last density pass
+  std::vector<std::uint8_t> phase;     // Phase
+  std::vector<std::uint8_t> material;  // index into Scene::materials
+  std::vector<std::uint32_t> id;       // stable identity: index at creation, survives sorting
+
+  std::size_t size() const { return position.size(); }
+  void resize(std::size_t n);
+  std::size_t count(Phase p) const;
+};
+
+}  // namespace thaw

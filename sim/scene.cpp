@@ -1,0 +1,307 @@
+// Loading a scene: file lookup, JSON reading, `--set` overrides, the checks that span several fields,
+// and the conversion of the validated document into the typed Scene. The fields themselves are
+// declared in sim/scene_schema.cpp.
+#include "sim/scene.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "sim/error.h"
+
+namespace thaw {
+
+namespace {
+
+// A sanity limit: beyond this a typo in `spacing` would exhaust memory before any error appears.
+constexpr double kMaxParticles = 20e6;
+constexpr std::array<char, 3> kAxis = {'x', 'y', 'z'};
+
+std::string format_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// 25000000 -> "25,000,000": particle counts are read by people deciding on a spacing.
+std::string format_count(double v) {
+  std::string digits = std::to_string(static_cast<long long>(std::llround(v)));
+  for (int i = static_cast<int>(digits.size()) - 3; i > 0; i -= 3)
+    digits.insert(static_cast<std::size_t>(i), ",");
+  return digits;
+}
+
+Eigen::Vector3d vec(const Json& v) { return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()}; }
+
+Box box(const Json& v) { return {vec(v["min"]), vec(v["max"])}; }
+
+void check_box(const Box& b, const std::string& path, const std::string& what) {
+  for (int a = 0; a < 3; ++a) {
+    if (b.max[a] <= b.min[a]) {
+      throw SceneError(path, what + ": max must be above min on every axis, but " + kAxis[a] + " runs from " +
+                                 format_number(b.min[a]) + " m to " + format_number(b.max[a]) + " m");
+    }
+  }
+}
+
+std::string names_of(const Json& materials, const std::string& kind) {
+  std::string out;
+  for (const auto& [name, m] : materials.items()) {
+    if (kind.empty() || m["kind"] == kind) out += (out.empty() ? "" : ", ") + name;
+  }
+  return out.empty() ? "none" : out;
+}
+
+// Index of a material in document order, checked to be of the wanted kind.
+int material_index(const Json& materials, const Json& name_value, const std::string& path,
+                   const std::string& kind, const std::string& user) {
+  const std::string name = name_value.get<std::string>();
+  int index = 0;
+  for (const auto& [defined, m] : materials.items()) {
+    if (defined == name) {
+      if (m["kind"] != kind) {
+        throw SceneError(path, "material '" + name + "' is a " + m["kind"].get<std::string>() + "; " + user +
+                                   " needs a " + kind + " (" + kind +
+                                   " materials: " + names_of(materials, kind) + ")");
+      }
+      return index;
+    }
+    ++index;
+  }
+  throw SceneError(path, "unknown material '" + name + "'; defined: " + names_of(materials, ""));
+}
+
+double wall_layer_count(const Json& doc) {
+  const int layers = doc["domain"]["wall_layers"].get<int>();
+  return layers > 0 ? layers : std::ceil(doc["solver"]["support_ratio"].get<double>());
+}
+
+// Fluid lattices plus boundary particles: enough to stop a spacing typo, not a promise of the count.
+double estimated_particles(const Scene& s, double wall_layers) {
+  const double h = s.spacing;
+  const Eigen::Vector3d extent = s.domain.max - s.domain.min;
+  double n = 0.0;
+  for (const FluidBlock& f : s.fluids) n += ((f.box.max - f.box.min) / h).array().floor().prod();
+  const double face_area[3] = {extent.y() * extent.z(), extent.x() * extent.z(), extent.x() * extent.y()};
+  for (const std::string& side : s.walls) n += face_area[side[1] - 'x'] * wall_layers / (h * h);
+  for (const Solid& solid : s.solids) {
+    if (solid.shape == Solid::Shape::Plane) {
+      n += *std::max_element(face_area, face_area + 3) * wall_layers / (h * h);
+    } else {
+      const Eigen::Vector3d e = solid.box.max - solid.box.min;
+      const double shell = 2.0 * (e.x() * e.y() + e.y() * e.z() + e.x() * e.z()) * wall_layers / (h * h);
+      n += std::min(shell, e.prod() / (h * h * h));
+    }
+  }
+  return n;
+}
+
+// Checks that span several fields; `doc` has passed validation, so every field is present and typed.
+Scene convert_and_check(const Json& doc) {
+  Scene s;
+  s.name = doc["name"].get<std::string>();
+  s.description = doc["description"].get<std::string>();
+  s.gravity = vec(doc["gravity"]);
+  s.spacing = doc["spacing"].get<double>();
+  s.solver = solver_settings_from_json(doc["solver"]);
+
+  const Json& domain = doc["domain"];
+  s.domain = box(domain);
+  check_box(s.domain, "domain", "empty domain");
+  const double smallest = (s.domain.max - s.domain.min).minCoeff();
+  if (s.spacing >= smallest) {
+    throw SceneError("spacing", format_number(s.spacing) +
+                                    " m is not smaller than the smallest extent of the domain (" +
+                                    format_number(smallest) + " m)");
+  }
+
+  const Json& materials = doc["materials"];
+  for (const auto& [name, m] : materials.items()) {
+    s.materials.push_back(
+        {name, m["kind"].get<std::string>(), m["density"].get<double>(), m["viscosity"].get<double>()});
+  }
+
+  s.walls = domain["walls"].get<std::vector<std::string>>();
+  s.wall_layers = domain["wall_layers"].get<int>();
+  if (domain.contains("wall_material")) {
+    s.wall_material = material_index(materials, domain["wall_material"], "domain.wall_material", "solid",
+                                     "the domain walls");
+  } else if (!s.walls.empty()) {
+    throw SceneError("domain.wall_material", "missing: required because domain.walls is not empty");
+  }
+
+  for (std::size_t i = 0; i < doc["fluids"].size(); ++i) {
+    const Json& f = doc["fluids"][i];
+    const std::string path = join_path("fluids", i);
+    FluidBlock block;
+    block.material = material_index(materials, f["material"], path + ".material", "fluid", "a fluid block");
+    block.box = box(f["box"]);
+    block.velocity = vec(f["velocity"]);
+    check_box(block.box, path + ".box", "empty box");
+    for (int a = 0; a < 3; ++a) {
+      if (block.box.min[a] < s.domain.min[a] || block.box.max[a] > s.domain.max[a]) {
+        throw SceneError(path + ".box", std::string("lies outside the domain along ") + kAxis[a] + ": " +
+                                            format_number(block.box.min[a]) + " m to " +
+                                            format_number(block.box.max[a]) + " m, the domain spans " +
+                                            format_number(s.domain.min[a]) + " m to " +
+                                            format_number(s.domain.max[a]) + " m");
+      }
+    }
+    s.fluids.push_back(block);
+  }
+
+  for (std::size_t i = 0; i < doc["solids"].size(); ++i) {
+    const Json& j = doc["solids"][i];
+    const std::string path = join_path("solids", i);
+    Solid solid;
+    solid.material = material_index(materials, j["material"], path + ".material", "solid", "a solid");
+    if (j["shape"] == "box") {
+      solid.shape = Solid::Shape::Box;
+      solid.box = box(j["box"]);
+      check_box(solid.box, path + ".box", "empty box");
+    } else {
+      solid.shape = Solid::Shape::Plane;
+      solid.point = vec(j["point"]);
+      solid.normal = vec(j["normal"]);
+      if (solid.normal.norm() == 0.0) throw SceneError(path + ".normal", "must not be zero");
+      solid.normal.normalize();
+    }
+    s.solids.push_back(solid);
+  }
+
+  const double n = estimated_particles(s, wall_layer_count(doc));
+  if (n > kMaxParticles) {
+    throw SceneError("spacing", "about " + format_count(n) + " particles at " + format_number(s.spacing) +
+                                    " m, more than the limit of " + format_count(kMaxParticles) +
+                                    "; increase the spacing or shrink the scene");
+  }
+  if (s.solver.min_dt >= s.solver.max_dt) {
+    throw SceneError("solver.min_dt", format_number(s.solver.min_dt) + " s must be below solver.max_dt (" +
+                                          format_number(s.solver.max_dt) + " s)");
+  }
+  s.source = doc;
+  return s;
+}
+
+// Line and column (1-based) of a 0-based byte offset, as editors count them.
+std::string location(const std::string& text, std::size_t offset) {
+  offset = std::min(offset, text.size());
+  const std::size_t line =
+      1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + offset, '\n'));
+  const std::size_t last_newline = offset == 0 ? std::string::npos : text.rfind('\n', offset - 1);
+  const std::size_t column = last_newline == std::string::npos ? offset + 1 : offset - last_newline;
+  return std::to_string(line) + ":" + std::to_string(column);
+}
+
+// nlohmann's message without its "[json.exception...] parse error at line 1, column 2: " prefix.
+std::string parse_reason(const std::string& what) {
+  std::size_t start = what.find("column ");
+  start = what.find(": ", start == std::string::npos ? 0 : start);
+  return start == std::string::npos ? what : what.substr(start + 2);
+}
+
+}  // namespace
+
+SolverSettings solver_settings_from_json(const Json& j) {
+  SolverSettings s;
+  s.kernel = j["kernel"].get<std::string>();
+  s.support_ratio = j["support_ratio"].get<double>();
+  s.eos = j["eos"].get<std::string>();
+  s.gamma = j["gamma"].get<double>();
+  s.speed_of_sound = j["speed_of_sound"].get<double>();
+  s.sound_speed_factor = j["sound_speed_factor"].get<double>();
+  s.reference_speed = j["reference_speed"].get<double>();
+  s.artificial_viscosity = j["artificial_viscosity"].get<double>();
+  s.boundary_viscosity = j["boundary_viscosity"].get<double>();
+  s.boundary_volume = j["boundary_volume"].get<std::string>();
+  s.cfl = j["cfl"].get<double>();
+  s.viscous_number = j["viscous_number"].get<double>();
+  s.force_number = j["force_number"].get<double>();
+  s.max_dt = j["max_dt"].get<double>();
+  s.min_dt = j["min_dt"].get<double>();
+  s.max_speed = j["max_speed"].get<double>();
+  s.output_interval = j["output_interval"].get<double>();
+  s.sort_every = j["sort_every"].get<int>();
+  return s;
+}
+
+void apply_override(Json& doc, const std::string& assignment) {
+  apply_override(doc, assignment, scene_schema());
+}
+
+void apply_override(Json& doc, const std::string& assignment, const Field& schema) {
+  const std::size_t eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw Error("--set '" + assignment + "': expected PATH=VALUE, e.g. solver.cfl=0.3");
+  }
+  const std::string path = assignment.substr(0, eq);
+  const std::string text = assignment.substr(eq + 1);
+  Json value;
+  try {
+    value = Json::parse(text);
+  } catch (const Json::parse_error&) {
+    value = text;  // solver.kernel=wendland_c2 needs no quotes
+  } catch (const Json::out_of_range&) {
+    throw SceneError(path, "number " + text + " is out of range");
+  }
+  set_at_path(doc, path, std::move(value), &schema);
+}
+
+Scene scene_from_json(Json doc, const std::vector<std::string>& overrides) {
+  for (const std::string& o : overrides) apply_override(doc, o);
+  validate(doc, scene_schema());
+  return convert_and_check(doc);
+}
+
+std::string resolve_scene_path(const std::string& name) {
+  namespace fs = std::filesystem;
+  const fs::path configs = fs::path(THAW_SOURCE_DIR) / "configs";
+  std::vector<fs::path> candidates = {name};
+  if (fs::path(name).extension() != ".json") candidates.emplace_back(name + ".json");
+  if (!fs::path(name).is_absolute()) {
+    candidates.push_back(configs / name);
+    if (fs::path(name).extension() != ".json") candidates.push_back(configs / (name + ".json"));
+  }
+  std::string looked;
+  for (const fs::path& p : candidates) {
+    std::error_code ec;
+    if (fs::is_regular_file(p, ec)) return p.string();
+    looked += (looked.empty() ? "" : ", ") + p.string();
+  }
+  throw Error("scene '" + name + "' not found; looked for " + looked);
+}
+
+Json read_json_file(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(file + ": cannot open file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  try {
+    return Json::parse(text, nullptr, true, true);
+  } catch (const Json::parse_error& e) {
+    const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
+    throw Error(file + ":" + location(text, offset) + ": invalid JSON: " + parse_reason(e.what()));
+  } catch (const Json::out_of_range& e) {
+    // Overflow ("1e400") carries no position; the literal itself, quoted in the message, locates it.
+    const std::string what = e.what();
+    const std::size_t open = what.find('\'');
+    const std::size_t close = what.rfind('\'');
+    const std::string literal = open < close ? what.substr(open + 1, close - open - 1) : std::string();
+    const std::size_t at = literal.empty() ? std::string::npos : text.find(literal);
+    const std::string where = at == std::string::npos ? "" : ":" + location(text, at);
+    throw Error(file + where + ": invalid JSON: number " + literal + " is out of range of a double");
+  }
+}
+
+Scene load_scene(const std::string& file, const std::vector<std::string>& overrides) {
+  const std::string path = resolve_scene_path(file);
+  Json doc = read_json_file(path);
+  if (doc.is_object() && !doc.contains("name")) doc["name"] = std::filesystem::path(path).stem().string();
+  return scene_from_json(std::move(doc), overrides);
+}
+
+}  // namespace thaw

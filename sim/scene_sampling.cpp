@@ -1,0 +1,127 @@
+// Turning a scene into particles: fluid on a lattice, solids and walls as boundary particles.
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "sim/error.h"
+#include "sim/solver.h"
+
+namespace thaw {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+bool inside(const Box& b, const Vec3& p) {
+  return (p.array() >= b.min.array()).all() && (p.array() <= b.max.array()).all();
+}
+
+// Lattice points min + (i + 1/2) dx filling [min, max].
+template <class F>
+void lattice(const Vec3& min, const Vec3& max, double dx, F&& visit) {
+  const Eigen::Array3i n =
+      ((max - min) / dx).array().unaryExpr([](double v) { return static_cast<int>(std::floor(v + 1e-6)); });
+  for (int k = 0; k < n.z(); ++k)
+    for (int j = 0; j < n.y(); ++j)
+      for (int i = 0; i < n.x(); ++i) visit(Vec3(min + dx * Vec3(i + 0.5, j + 0.5, k + 0.5)));
+}
+
+int layer_count(const Scene& s) {
+  return s.wall_layers > 0 ? s.wall_layers : static_cast<int>(std::ceil(s.solver.support_ratio - 1e-9));
+}
+
+void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase, int material) {
+  p.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
+  p.velocity.push_back({float(v.x()), float(v.y()), float(v.z()), 0.f});
+  p.density.push_back(0.f);
+  p.phase.push_back(static_cast<std::uint8_t>(phase));
+  p.material.push_back(static_cast<std::uint8_t>(material));
+  p.id.push_back(static_cast<std::uint32_t>(p.id.size()));
+}
+
+}  // namespace
+
+HostParticles sample_scene(const Scene& scene) {
+  HostParticles p;
+  const double dx = scene.spacing;
+  const int layers = layer_count(scene);
+  const double depth = layers * dx;
+
+  // Boundary particles first; their mass (Psi) is left 0 for the solver to compute.
+  auto in_solid = [&](const Vec3& x) {
+    for (const auto& s : scene.solids) {
+      if (s.shape == Solid::Shape::Box && inside(s.box, x)) return true;
+      if (s.shape == Solid::Shape::Plane && (x - s.point).dot(s.normal.normalized()) < 0) return true;
+    }
+    return false;
+  };
+  for (const auto& s : scene.solids) {
+    if (s.shape == Solid::Shape::Box) {
+      lattice(s.box.min, s.box.max, dx, [&](const Vec3& x) {
+        const double to_face = std::min((x - s.box.min).minCoeff(), (s.box.max - x).minCoeff());
+        if (to_face < depth) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material);
+      });
+    } else {
+      // Layers behind the plane, clipped to the domain grown by the layer depth.
+      const Vec3 nrm = s.normal.normalized();
+      const Vec3 u = nrm.unitOrthogonal(), v = nrm.cross(u);
+      Box grown{scene.domain.min - Vec3::Constant(depth), scene.domain.max + Vec3::Constant(depth)};
+      double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
+      for (int c = 0; c < 8; ++c) {
+        const Vec3 corner((c & 1) ? grown.max.x() : grown.min.x(), (c & 2) ? grown.max.y() : grown.min.y(),
+                          (c & 4) ? grown.max.z() : grown.min.z());
+        umin = std::min(umin, (corner - s.point).dot(u));
+        umax = std::max(umax, (corner - s.point).dot(u));
+        vmin = std::min(vmin, (corner - s.point).dot(v));
+        vmax = std::max(vmax, (corner - s.point).dot(v));
+      }
+      for (double a = std::floor(umin / dx) * dx; a <= umax; a += dx)
+        for (double b = std::floor(vmin / dx) * dx; b <= vmax; b += dx)
+          for (int k = 0; k < layers; ++k) {
+            const Vec3 x = s.point + (a + 0.5 * dx) * u + (b + 0.5 * dx) * v - (k + 0.5) * dx * nrm;
+            if (inside(grown, x)) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material);
+          }
+    }
+  }
+  // Domain walls: lattice points outside the domain, within the layer depth, on walled sides only.
+  if (!scene.walls.empty()) {
+    const auto& d = scene.domain;
+    auto walled = [&](int axis, bool upper) {
+      const std::string side = std::string(upper ? "+" : "-") + "xyz"[axis];
+      for (const auto& w : scene.walls)
+        if (w == side) return true;
+      return false;
+    };
+    const Vec3 lo = d.min - Vec3::Constant(depth), hi = d.max + Vec3::Constant(depth);
+    const Vec3 start = d.min - Vec3::Constant(depth);
+    lattice(start, hi, dx, [&](const Vec3& x) {
+      bool outside = false, ok = true;
+      for (int a = 0; a < 3; ++a) {
+        if (x[a] < d.min[a]) outside = true, ok = ok && walled(a, false);
+        if (x[a] > d.max[a]) outside = true, ok = ok && walled(a, true);
+      }
+      if (outside && ok && inside(Box{lo, hi}, x))
+        add(p, x, Vec3::Zero(), 0.f, Phase::Solid, scene.wall_material);
+    });
+  }
+  // Fluid blocks, skipping lattice points inside solids or an earlier block.
+  for (std::size_t b = 0; b < scene.fluids.size(); ++b) {
+    const auto& f = scene.fluids[b];
+    const float mass = static_cast<float>(scene.materials[f.material].density * dx * dx * dx);
+    lattice(f.box.min, f.box.max, dx, [&](const Vec3& x) {
+      if (!inside(scene.domain, x) || in_solid(x)) return;
+      for (std::size_t e = 0; e < b; ++e)
+        if (inside(scene.fluids[e].box, x)) return;
+      add(p, x, f.velocity, mass, Phase::Water, f.material);
+    });
+  }
+  if (p.size() > std::size_t(0xffffffffu)) throw SceneError("spacing", "too many particles for 32-bit ids");
+  return p;
+}
+
+SimState initial_state(const Scene& scene) {
+  SimState s;
+  s.particles = sample_scene(scene);
+  s.scene_json = scene.source.dump();
+  return s;
+}
+
+}  // namespace thaw

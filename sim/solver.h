@@ -1,0 +1,114 @@
+#pragma once
+// Weakly compressible SPH water with static boundary particles, stepped on an OpenCL device.
+// One step (see Solver::step): grid -> density -> forces -> time step -> integrate.
+#include <cstdint>
+#include <string>
+
+#include "sim/cl_runtime.h"
+#include "sim/particles.h"
+#include "sim/scene.h"
+#include "sim/stage_timers.h"
+#include "sim/state_file.h"
+
+namespace thaw {
+
+// Constants the scene implies, derived once (speed of sound, kernel radius, EOS stiffness).
+struct SolverConstants {
+  float support = 0;         // kernel support radius H [m]
+  float smoothing = 0;       // h = H / 2 (CFL and viscosity length) [m]
+  float rest_density = 0;    // rho0 of the fluid [kg/m^3]
+  float sound_speed = 0;     // c [m/s]
+  float stiffness = 0;       // Tait B = rho0 c^2 / gamma, or rho0 c^2 for the linear EOS [Pa]
+  float kinematic_viscosity = 0;  // physical nu [m^2/s]
+  float max_speed = 0;       // blow-up threshold [m/s]
+};
+SolverConstants derive_constants(const Scene& scene);
+
+class Solver {
+ public:
+  // Starts from a state: a fresh one from initial_state(), or one read from a state file.
+  Solver(ClRuntime& cl, const Scene& scene, const SimState& state);
+
+  // One time step. Throws BlowUpError naming the step and the particle when the state is not finite
+  // or runs away, or when the adaptive time step collapses below the scene's min_dt.
+  void step();
+
+  // Builds and first-enqueues every kernel on the current state without advancing it, so the
+  // JIT compilation of the first launch is not timed.
+  void warm_up();
+
+  // Velocity relaxation rate zeta [1/s] for settling an initial state (validation cases); 0 = none.
+  void set_velocity_damping(double zeta) { damping_ = zeta; }
+
+  SimState state() const;  // copies the device state to the host
+  HostParticles particles() const;
+
+  double time() const { return time_; }
+  double dt() const { return dt_; }
+  std::uint64_t steps() const { return steps_; }
+  std::uint64_t clamped() const;
+  std::size_t size() const { return n_; }
+  const SolverConstants& constants() const { return k_; }
+  const StageTimers& timers() const { return timers_; }
+  StageTimers& timers() { return timers_; }
+  const Scene& scene() const { return scene_; }
+
+  // Stage entry points, exposed for benchmarks and tests; step() is their composition.
+  void build_grid();
+  void compute_density();
+  void compute_forces();
+  double choose_time_step();
+  void integrate(double dt);
+
+  // Cell geometry of the neighbour grid (for reference loops and tests).
+  struct GridInfo {
+    Eigen::Vector3f origin;
+    float cell = 0;
+    int nx = 0, ny = 0, nz = 0;
+    int reach = 1;  // cells visited on each side
+  };
+  const GridInfo& grid() const { return grid_; }
+  std::vector<std::uint32_t> cell_starts() const;
+  std::vector<float> densities() const;
+  std::vector<Float4> pressure_state() const;  // per particle (rho, p/rho^2, is_boundary, p)
+
+ private:
+  void compute_boundary_psi();
+  void upload(const HostParticles& p);
+  template <class F>
+  void timed(Stage s, F&& f);
+
+  ClRuntime& cl_;
+  Scene scene_;
+  SolverConstants k_;
+  std::size_t n_ = 0;
+  double time_ = 0, dt_ = 0;
+  std::uint64_t steps_ = 0;
+  std::uint64_t clamped_base_ = 0;
+  double damping_ = 0;
+  StageTimers timers_;
+  GridInfo grid_;
+  std::uint32_t ncells_ = 0;
+  std::uint32_t sort_passes_ = 0;
+  std::uint32_t tile_ = 256, ntiles_ = 0;
+
+  // Per-particle state, reordered with the sort.
+  cl::Buffer position_, velocity_, density_, phase_, material_, id_;
+  // Derived each step.
+  cl::Buffer state_, accel_;
+  // Scratch: sort keys/values (two of each), histogram, spares for the gathers, cell starts, limits.
+  cl::Buffer keys_[2], order_[2], hist_, totals_, spare4_, spare1f_, spare_u_, spare_c_, cell_start_;
+  cl::Buffer clamped_, limits_f_, limits_i_;
+
+  cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_, k_g4_, k_gf_, k_gu_, k_gc_;
+  cl::Kernel k_psi_, k_set_mass_, k_density_, k_forces_, k_limits_, k_integrate_;
+};
+
+// Samples a scene into particles: fluid blocks on a lattice, static solids and domain walls as
+// boundary particles (their Psi is computed on the device when the solver starts).
+HostParticles sample_scene(const Scene& scene);
+
+// The state a run starts from: sampled particles at t = 0.
+SimState initial_state(const Scene& scene);
+
+}  // namespace thaw

@@ -1,0 +1,419 @@
+#include "sim/state_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <type_traits>
+#include <vector>
+
+#include "sim/error.h"
+
+namespace thaw {
+namespace {
+
+// "\x89" catches 7-bit transfers, "\r\n" newline translation, "\x1a" a DOS `type` — as in PNG.
+constexpr std::array<char, 8> kMagic = {'\x89', 'T', 'H', 'A', 'W', '\r', '\n', '\x1a'};
+constexpr std::uint32_t kByteOrderMark = 0x01020304;
+constexpr std::uint32_t kSectionRequired = 1;
+constexpr std::size_t kPrefixBytes = 8 + 4 + 4;  // magic, version, byte order: the same in every version
+constexpr std::size_t kHeaderBytes = kPrefixBytes + 7 * 8 + 2 * 4 + 8;
+constexpr std::size_t kTrailerBytes = 8;
+constexpr std::size_t kMaxSectionName = 256;
+
+std::string errno_text(int err) { return std::strerror(err); }
+
+Error file_error(const std::string& path, const std::string& what) {
+  return Error("state file '" + path + "': " + what);
+}
+
+// Copies `bytes` of arrays whose scalars are `word` bytes wide between host order and the file's
+// little-endian order. A plain copy on little-endian hosts; memcpy keeps every bit (NaN payloads too).
+void copy_little_endian(char* dst, const char* src, std::size_t bytes, std::size_t word) {
+  if constexpr (std::endian::native == std::endian::little) {
+    if (bytes != 0) std::memcpy(dst, src, bytes);
+  } else {
+    for (std::size_t at = 0; at < bytes; at += word) {
+      for (std::size_t k = 0; k < word; ++k) dst[at + k] = src[at + word - 1 - k];
+    }
+  }
+}
+
+class ByteWriter {
+ public:
+  void u32(std::uint32_t v) { scalar(v); }
+  void u64(std::uint64_t v) { scalar(v); }
+  void f64(const double& v) { scalar(v); }
+  void bytes(std::string_view b) { out_.append(b); }
+  // A whole array at once: the state of a million particles encodes at memory speed.
+  void words(const void* data, std::size_t bytes, std::size_t word) {
+    const std::size_t at = out_.size();
+    out_.resize(at + bytes);
+    copy_little_endian(out_.data() + at, static_cast<const char*>(data), bytes, word);
+  }
+  void reserve(std::size_t n) { out_.reserve(n); }
+  std::string& buffer() { return out_; }
+
+ private:
+  template <typename T>
+  void scalar(const T& v) {
+    words(&v, sizeof v, sizeof v);
+  }
+  std::string out_;
+};
+
+std::uint64_t load_u64(std::string_view data, std::size_t at) {
+  std::uint64_t v;
+  copy_little_endian(reinterpret_cast<char*>(&v), data.data() + at, sizeof v, sizeof v);
+  return v;
+}
+
+std::uint32_t load_u32(std::string_view data, std::size_t at) {
+  std::uint32_t v;
+  copy_little_endian(reinterpret_cast<char*>(&v), data.data() + at, sizeof v, sizeof v);
+  return v;
+}
+
+// Bounds-checked reads over a verified buffer; a failure here means a malformed (not corrupted) file.
+class ByteReader {
+ public:
+  ByteReader(const std::string& path, std::string_view data, std::size_t pos)
+      : path_(path), data_(data), pos_(pos) {}
+
+  std::uint32_t u32() { return load_u32(bytes(4, "a field"), 0); }
+  std::uint64_t u64() { return load_u64(bytes(8, "a field"), 0); }
+  // Into the destination's memory, never through a float value the optimiser may canonicalise.
+  void f64(double& dst) {
+    copy_little_endian(reinterpret_cast<char*>(&dst), bytes(8, "a field").data(), 8, 8);
+  }
+  std::string_view bytes(std::uint64_t n, const std::string& what) {
+    if (n > remaining()) {
+      throw file_error(path_, "malformed: " + what + " needs " + std::to_string(n) + " bytes at offset " +
+                                  std::to_string(pos_) + ", only " + std::to_string(remaining()) + " remain");
+    }
+    std::string_view b = data_.substr(pos_, static_cast<std::size_t>(n));
+    pos_ += static_cast<std::size_t>(n);
+    return b;
+  }
+  std::size_t pos() const { return pos_; }
+  std::size_t remaining() const { return data_.size() - pos_; }
+
+ private:
+  const std::string& path_;
+  std::string_view data_;
+  std::size_t pos_;
+};
+
+std::string hex(std::uint64_t v) {
+  char buf[19];
+  std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+// Width of the scalars an element is made of, for byte order: a Float4 is four 4-byte words.
+template <typename T>
+constexpr std::size_t word_size() {
+  if constexpr (std::is_same_v<T, Float4>) {
+    return sizeof(float);
+  } else {
+    static_assert(std::is_arithmetic_v<T>, "a section element is a scalar or a Float4");
+    return sizeof(T);
+  }
+}
+
+// Every per-particle array that a state file holds, with its section name. Fields added to
+// HostParticles (temperature, enthalpy, body id) get a line here; readers of older versions then
+// refuse the file by the section's required flag instead of resuming without the field.
+template <typename Particles, typename Visit>
+void for_each_array(Particles& p, Visit&& visit) {
+  visit("position", p.position);
+  visit("velocity", p.velocity);
+  visit("density", p.density);
+  visit("phase", p.phase);
+  visit("material", p.material);
+  visit("id", p.id);
+}
+
+// The arrays of one HostParticles must agree in length before they are written.
+std::optional<std::string> inconsistent_sizes(const HostParticles& p) {
+  std::optional<std::string> problem;
+  for_each_array(p, [&](const char* name, const auto& array) {
+    if (!problem && array.size() != p.position.size()) {
+      problem = "array sizes inconsistent: position has " + std::to_string(p.position.size()) +
+                " elements, " + name + " has " + std::to_string(array.size());
+    }
+  });
+  return problem;
+}
+
+std::string encode_state(const SimState& s) {
+  const HostParticles& p = s.particles;
+  std::uint32_t sections = 0;
+  std::size_t body = 0;
+  for_each_array(p, [&](const char* name, const auto& array) {
+    ++sections;
+    body += 4 + std::strlen(name) + 4 + 4 + 8 + array.size() * sizeof(array[0]);
+  });
+  const std::size_t total = kHeaderBytes + s.scene_json.size() + body + kTrailerBytes;
+
+  ByteWriter w;
+  w.reserve(total);
+  w.bytes(std::string_view(kMagic.data(), kMagic.size()));
+  w.u32(kStateFileVersion);
+  w.u32(kByteOrderMark);
+  w.u64(total);
+  w.u64(p.size());
+  w.u64(s.step);
+  w.f64(s.time);
+  w.f64(s.dt);
+  w.u64(s.clamped);
+  w.u64(s.scene_json.size());
+  w.u32(sections);
+  w.u32(0);
+  w.u64(fnv1a64(w.buffer()));
+
+  w.bytes(s.scene_json);
+  for_each_array(p, [&](const char* name, const auto& array) {
+    using Element = std::remove_cvref_t<decltype(array[0])>;
+    const std::size_t name_length = std::strlen(name);
+    w.u32(static_cast<std::uint32_t>(name_length));
+    w.bytes(std::string_view(name, name_length));
+    w.u32(kSectionRequired);
+    w.u32(sizeof(Element));
+    w.u64(array.size());
+    w.words(array.data(), array.size() * sizeof(Element), word_size<Element>());
+  });
+  w.u64(fnv1a64(w.buffer()));
+  return std::move(w.buffer());
+}
+
+std::string read_whole_file(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw file_error(path, "cannot open: " + errno_text(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    throw file_error(path, "cannot stat: " + errno_text(err));
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw file_error(path, "not a regular file");
+  }
+  std::string data(static_cast<std::size_t>(st.st_size), '\0');
+  std::size_t got = 0;
+  while (got < data.size()) {
+    const ssize_t r = ::read(fd, data.data() + got, data.size() - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) {
+      const int err = errno;
+      ::close(fd);
+      throw file_error(path, "cannot read: " + errno_text(err));
+    }
+    if (r == 0) break;  // shrank while reading; the size checks below report it
+    got += static_cast<std::size_t>(r);
+  }
+  ::close(fd);
+  data.resize(got);
+  return data;
+}
+
+SimState decode_state(const std::string& path, std::string_view data) {
+  // The prefix is checked field by field so each kind of wrong file gets its own message.
+  const std::string_view magic(kMagic.data(), kMagic.size());
+  if (data.size() < magic.size()) {
+    if (magic.starts_with(data)) {
+      throw file_error(path, "truncated: expected at least " + std::to_string(kHeaderBytes) +
+                                 " bytes, found " + std::to_string(data.size()));
+    }
+    throw file_error(path, "not a thaw state file (bad magic)");
+  }
+  if (data.substr(0, magic.size()) != magic) throw file_error(path, "not a thaw state file (bad magic)");
+  if (data.size() < kPrefixBytes) {
+    throw file_error(path, "truncated: expected at least " + std::to_string(kHeaderBytes) + " bytes, found " +
+                               std::to_string(data.size()));
+  }
+  const std::uint32_t version = load_u32(data, 8);
+  if (version != kStateFileVersion) {
+    throw file_error(path, "unsupported format version " + std::to_string(version) +
+                               " (this build reads version " + std::to_string(kStateFileVersion) + " only)");
+  }
+  const std::uint32_t mark = load_u32(data, 12);
+  if (mark != kByteOrderMark) {
+    throw file_error(path, "bad byte-order marker " + hex(mark) + " (file is corrupt)");
+  }
+  if (data.size() < kHeaderBytes) {
+    throw file_error(path, "truncated: expected at least " + std::to_string(kHeaderBytes) + " bytes, found " +
+                               std::to_string(data.size()));
+  }
+
+  // The header has its own sum so its file size can be trusted to tell truncation from corruption.
+  const std::uint64_t header_sum = load_u64(data, kHeaderBytes - 8);
+  const std::uint64_t header_computed = fnv1a64(data.substr(0, kHeaderBytes - 8));
+  if (header_sum != header_computed) {
+    throw file_error(path, "header checksum mismatch (file is corrupt): stored " + hex(header_sum) +
+                               ", computed " + hex(header_computed));
+  }
+  ByteReader r(path, data, kPrefixBytes);
+  const std::uint64_t file_size = r.u64();
+  if (file_size != data.size()) {
+    throw file_error(path, std::string(data.size() < file_size ? "truncated" : "trailing bytes") +
+                               ": expected " + std::to_string(file_size) + " bytes, found " +
+                               std::to_string(data.size()));
+  }
+  const std::uint64_t sum = load_u64(data, data.size() - kTrailerBytes);
+  const std::uint64_t computed = fnv1a64(data.substr(0, data.size() - kTrailerBytes));
+  if (sum != computed) {
+    throw file_error(
+        path, "checksum mismatch (file is corrupt): stored " + hex(sum) + ", computed " + hex(computed));
+  }
+
+  SimState s;
+  const std::uint64_t n = r.u64();
+  s.step = r.u64();
+  r.f64(s.time);
+  r.f64(s.dt);
+  s.clamped = r.u64();
+  const std::uint64_t scene_bytes = r.u64();
+  const std::uint32_t section_count = r.u32();
+  r.u32();  // flags: none defined in version 1
+  r.u64();  // header sum, verified above
+  s.scene_json = std::string(r.bytes(scene_bytes, "the scene JSON"));
+
+  // Sections end before the trailer; reading past it would treat the checksum as data.
+  ByteReader sections(path, data.substr(0, data.size() - kTrailerBytes), r.pos());
+  if (n > sections.remaining()) {
+    throw file_error(path, "array sizes inconsistent: header says " + std::to_string(n) +
+                               " particles, more than the file can hold");
+  }
+  s.particles.resize(static_cast<std::size_t>(n));
+  std::vector<std::string> seen;
+  for (std::uint32_t k = 0; k < section_count; ++k) {
+    const std::uint32_t name_length = sections.u32();
+    if (name_length > kMaxSectionName) {
+      throw file_error(path, "malformed: section " + std::to_string(k) + " has a name of " +
+                                 std::to_string(name_length) + " bytes");
+    }
+    const std::string name(sections.bytes(name_length, "section name"));
+    const std::uint32_t flags = sections.u32();
+    const std::uint32_t element_size = sections.u32();
+    const std::uint64_t count = sections.u64();
+    if (element_size != 0 && count > sections.remaining() / element_size) {
+      throw file_error(path, "malformed: section '" + name + "' declares " + std::to_string(count) +
+                                 " elements of " + std::to_string(element_size) +
+                                 " bytes, more than the file holds");
+    }
+    const std::string_view payload = sections.bytes(count * element_size, "section '" + name + "'");
+    if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+      throw file_error(path, "malformed: section '" + name + "' appears twice");
+    }
+    seen.push_back(name);
+
+    bool known = false;
+    for_each_array(s.particles, [&](const char* array_name, auto& array) {
+      using Element = std::remove_cvref_t<decltype(array[0])>;
+      if (name != array_name) return;
+      known = true;
+      if (element_size != sizeof(Element)) {
+        throw file_error(path, "section '" + name + "' has elements of " + std::to_string(element_size) +
+                                   " bytes, expected " + std::to_string(sizeof(Element)));
+      }
+      if (count != n) {
+        throw file_error(path, "array sizes inconsistent: section '" + name + "' has " +
+                                   std::to_string(count) + " elements, header says " + std::to_string(n) +
+                                   " particles");
+      }
+      copy_little_endian(reinterpret_cast<char*>(array.data()), payload.data(), payload.size(),
+                         word_size<Element>());
+    });
+    if (!known && (flags & kSectionRequired)) {
+      throw file_error(path, "unknown required section '" + name +
+                                 "' (written by a newer thaw; this build cannot resume it)");
+    }
+  }
+  if (sections.remaining() != 0) {
+    throw file_error(path, "malformed: " + std::to_string(sections.remaining()) +
+                               " unexplained bytes after " + std::to_string(section_count) + " sections");
+  }
+  for_each_array(s.particles, [&](const char* array_name, const auto&) {
+    if (std::find(seen.begin(), seen.end(), array_name) == seen.end()) {
+      throw file_error(path, std::string("missing required section '") + array_name + "'");
+    }
+  });
+  for (std::size_t i = 0; i < n; ++i) {
+    if (s.particles.phase[i] >= kPhaseCount) {
+      throw file_error(path, "particle " + std::to_string(i) + " has phase " +
+                                 std::to_string(s.particles.phase[i]) + " (valid: 0.." +
+                                 std::to_string(kPhaseCount - 1) + ")");
+    }
+  }
+  return s;
+}
+
+// Closes fd (if open), removes the temp file (if any) and throws; `err` is errno captured at the failure,
+// before anything else could overwrite it.
+[[noreturn]] void fail_write(const std::string& path, const std::string& tmp, int fd, int err,
+                             const std::string& step) {
+  if (fd >= 0) ::close(fd);
+  if (!tmp.empty()) ::unlink(tmp.c_str());
+  throw Error("cannot write '" + path + "': " + step + ": " + errno_text(err));
+}
+
+}  // namespace
+
+std::uint64_t fnv1a64(std::string_view bytes, std::uint64_t hash) {
+  for (char c : bytes) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 0x100000001b3ull;
+  }
+  return hash;
+}
+
+void write_file_atomically(const std::string& path, std::string_view bytes, Durability durability) {
+  // Same directory as the target: rename is atomic only within one file system.
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  // O_TRUNC, not O_EXCL: a leftover with our pid is from a dead process that had it before us.
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail_write(path, "", -1, errno, "cannot create temp file '" + tmp + "'");
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t w = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w < 0) fail_write(path, tmp, fd, errno, "write to '" + tmp + "' failed");
+    done += static_cast<std::size_t>(w);
+  }
+  // Without this fsync a power cut after the rename can leave an empty file under the final name.
+  if (durability == Durability::Durable && ::fsync(fd) != 0) fail_write(path, tmp, fd, errno, "fsync failed");
+  if (::close(fd) != 0) fail_write(path, tmp, -1, errno, "close failed");
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    fail_write(path, tmp, -1, errno, "rename from '" + tmp + "' failed");
+  }
+  if (durability == Durability::Durable) {
+    // The rename itself is only durable once the directory entry is on disk.
+    std::string dir = std::filesystem::path(path).parent_path().string();
+    if (dir.empty()) dir = ".";
+    const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd < 0) fail_write(path, "", -1, errno, "cannot open directory '" + dir + "' to fsync it");
+    if (::fsync(dfd) != 0) fail_write(path, "", dfd, errno, "fsync of directory '" + dir + "' failed");
+    ::close(dfd);
+  }
+}
+
+void write_state_file(const std::string& path, const SimState& state) {
+  if (auto problem = inconsistent_sizes(state.particles)) {
+    throw Error("cannot write state file '" + path + "': " + *problem);
+  }
+  write_file_atomically(path, encode_state(state), Durability::Durable);
+}
+
+SimState read_state_file(const std::string& path) { return decode_state(path, read_whole_file(path)); }
+
+}  // namespace thaw

@@ -1,0 +1,76 @@
+#include "sim/validation/case.h"
+
+#include "sim/error.h"
+
+namespace thaw {
+
+bool CaseResult::passed() const {
+  if (metrics.empty()) return false;
+  for (const auto& [key, m] : metrics)
+    if (!m.passed()) return false;
+  return true;
+}
+
+Json CaseResult::to_json() const {
+  Json j;
+  j["case"] = name;
+  j["passed"] = passed();
+  j["res"] = res;
+  j["particles"] = particles;
+  j["steps"] = steps;
+  j["wall_s"] = wall_s;
+  Json m = Json::object();
+  for (const auto& [key, r] : metrics)
+    m[key] = {{"value", r.value}, {"reference", r.reference}, {"error", r.error}, {"gate", r.gate}};
+  j["metrics"] = m;
+  return j;
+}
+
+const std::vector<ValidationCase>& validation_cases() {
+  static const std::vector<ValidationCase> cases = {hydrostatic_case(), dam_break_case()};
+  return cases;
+}
+
+const ValidationCase& find_case(const std::string& name) {
+  std::string names;
+  for (const auto& c : validation_cases()) {
+    if (c.name == name) return c;
+    names += (names.empty() ? "" : ", ") + c.name;
+  }
+  throw Error("unknown validation case '" + name + "' (cases: " + names + ")");
+}
+
+Json case_parameters(const ValidationCase& c, const std::vector<std::string>& overrides) {
+  const Field schema = c.params();
+  Json doc = Json::object();
+  for (const auto& o : overrides) apply_override(doc, o, schema);
+  validate(doc, schema, "");
+  return doc;
+}
+
+CaseResult run_validation(ClRuntime& cl, const std::string& name, int res, const std::vector<std::string>& overrides) {
+  const auto& c = find_case(name);
+  if (res < 0) throw Error("--res must be positive");
+  const Json params = case_parameters(c, overrides);
+  CaseResult r = c.run(cl, params, res > 0 ? res : c.default_res);
+  r.name = c.name;
+  r.res = res > 0 ? res : c.default_res;
+  return r;
+}
+
+}  // namespace thaw
+
+namespace thaw {
+
+Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaults) {
+  Field f = solver_schema();
+  for (const auto& [key, value] : defaults) {
+    bool found = false;
+    for (auto& child : f.fields)
+      if (child.key == key) child.def(value), found = true;
+    if (!found) throw Error("solver_schema_with: no solver field '" + key + "'");
+  }
+  return f;
+}
+
+}  // namespace thaw

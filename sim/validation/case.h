@@ -1,0 +1,57 @@
+#pragma once
+// Validation cases: a scene built from the case's parameters plus the formula of its reference.
+// Every reference is computed from the parameters, so any of them can be changed with --set.
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sim/cl_runtime.h"
+#include "sim/schema.h"
+#include "sim/scene.h"
+
+namespace thaw {
+
+struct MetricResult {
+  double value = 0, reference = 0, error = 0, gate = 0;
+  bool passed() const { return error <= gate; }
+};
+
+struct CaseResult {
+  std::string name;
+  int res = 0;
+  std::size_t particles = 0;
+  std::uint64_t steps = 0;
+  double wall_s = 0;
+  std::vector<std::pair<std::string, MetricResult>> metrics;
+  bool passed() const;
+  Json to_json() const;
+};
+
+struct ValidationCase {
+  std::string name;
+  std::string summary;
+  int default_res;                  // particles across the characteristic length
+  std::function<Field()> params;    // the case's parameter document (may embed solver_schema())
+  std::function<CaseResult(ClRuntime&, const Json& params, int res)> run;
+};
+
+const std::vector<ValidationCase>& validation_cases();
+const ValidationCase& find_case(const std::string& name);  // throws Error listing the cases
+
+// Applies --set overrides to the case's parameters, validates them (errors name the path) and runs.
+CaseResult run_validation(ClRuntime& cl, const std::string& name, int res, const std::vector<std::string>& overrides);
+
+// The parameter document of a case after overrides and defaults.
+Json case_parameters(const ValidationCase& c, const std::vector<std::string>& overrides);
+
+// The cases, one file each.
+ValidationCase hydrostatic_case();
+ValidationCase dam_break_case();
+
+}  // namespace thaw
+
+namespace thaw {
+// solver_schema() with some defaults changed, for a case that needs other solver defaults.
+Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaults);
+}  // namespace thaw

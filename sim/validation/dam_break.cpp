@@ -1,0 +1,122 @@
+// Dam break (shared/VALIDATION.md §4): a water column of width a and height 2a collapses in a tank.
+// Reference: Martin & Moyce (1952), surge front Z/a against T* = t sqrt(2 g / a), dimensionless, so it
+// holds for any a and g; between their digitized points it is interpolated linearly.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "sim/error.h"
+#include "sim/metrics.h"
+#include "sim/solver.h"
+#include "sim/validation/case.h"
+
+namespace thaw {
+namespace {
+
+// Martin & Moyce 1952, column height 2a, a = 2.25 in (digitized; good to ~0.1-0.15 in Z/a).
+constexpr std::array<double, 8> kTStar = {0.832, 1.219, 1.997, 2.547, 3.345, 4.034, 4.418, 5.091};
+constexpr std::array<double, 8> kFront = {1.217, 1.474, 2.292, 2.995, 4.134, 4.944, 5.881, 6.980};
+
+double martin_moyce(double t_star) {
+  if (t_star <= kTStar.front()) {  // from Z/a = 1 at T* = 0 to the first point
+    return 1.0 + (kFront.front() - 1.0) * t_star / kTStar.front();
+  }
+  for (std::size_t i = 1; i < kTStar.size(); ++i)
+    if (t_star <= kTStar[i]) {
+      const double f = (t_star - kTStar[i - 1]) / (kTStar[i] - kTStar[i - 1]);
+      return kFront[i - 1] + f * (kFront[i] - kFront[i - 1]);
+    }
+  return kFront.back();
+}
+
+Field params() {
+  return object("", {
+      number("width", "Column width a").in("m").def(0.05715).above(0),
+      number("height_ratio", "Column height / a (Martin & Moyce's data are for 2)").def(2.0).above(0),
+      number("length_ratio", "Tank length / a").def(5.0).above(1),
+      integer("depth_particles", "Tank depth (y) in particle spacings; walls there are free-slip").def(4).at_least(1),
+      number("gravity", "Gravitational acceleration g").in("m/s^2").def(9.81).above(0),
+      number("density", "Rest density").in("kg/m^3").def(1000.0).above(0),
+      number("viscosity", "Dynamic viscosity").in("Pa s").def(1.0e-3).at_least(0),
+      number("t_star_min", "Start of the compared window in T* = t sqrt(2g/a)").def(1.0).at_least(0),
+      number("t_star_max", "End of the compared window in T*").def(3.0).above(0),
+      number("gate", "Gate on |Z - Z_ref| / Z_ref at each compared time").def(0.10).above(0),
+      solver_schema_with({{"artificial_viscosity", 0.02}}),
+  });
+}
+
+CaseResult run(ClRuntime& cl, const Json& prm, int res) {
+  const double a = prm["width"], g = prm["gravity"], rho0 = prm["density"];
+  const double t_lo = prm["t_star_min"], t_hi = prm["t_star_max"];
+  if (t_hi <= t_lo) throw SceneError("t_star_max", "must be larger than t_star_min");
+  const double dx = a / res;
+  const double L = double(prm["length_ratio"]) * a, Hc = double(prm["height_ratio"]) * a;
+  const double depth = int(prm["depth_particles"]) * dx;
+  Json doc = {
+      {"name", "validation/dam-break"},
+      {"domain", {{"min", {0, 0, 0}}, {"max", {L, depth, 1.5 * Hc}}, {"walls", {"-x", "+x", "-y", "+y", "-z"}},
+                  {"wall_material", "wall"}}},
+      {"gravity", {0, 0, -g}},
+      {"spacing", dx},
+      {"solver", prm["solver"]},
+      {"materials", {{"water", {{"kind", "fluid"}, {"density", rho0}, {"viscosity", prm["viscosity"]}}},
+                     {"wall", {{"kind", "solid"}, {"density", 2500.0}}}}},
+      {"fluids", {{{"material", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", {a, depth, Hc}}}}}}},
+  };
+  const Scene scene = scene_from_json(doc);
+
+  // Compared times: Martin & Moyce's own points inside the window, and the window's ends.
+  std::vector<double> samples = {t_lo};
+  for (double t : kTStar)
+    if (t > t_lo && t < t_hi) samples.push_back(t);
+  samples.push_back(t_hi);
+  const double t_scale = 1.0 / std::sqrt(2.0 * g / a);  // t = T* t_scale
+
+  Solver solver(cl, scene, initial_state(scene));
+  solver.warm_up();
+  const auto t0 = std::chrono::steady_clock::now();
+  auto front = [&] {
+    const auto p = solver.particles();
+    double x = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.phase[i] != static_cast<std::uint8_t>(Phase::Solid)) x = std::max(x, double(p.position[i][0]));
+    return (x + 0.5 * dx) / a;
+  };
+  std::vector<double> measured;
+  double prev_t = solver.time(), prev_z = front();
+  std::size_t next = 0;
+  while (next < samples.size()) {
+    solver.step();
+    const double t = solver.time(), z = front();
+    while (next < samples.size() && t >= samples[next] * t_scale) {
+      const double f = (samples[next] * t_scale - prev_t) / (t - prev_t);
+      measured.push_back(prev_z + f * (z - prev_z));
+      ++next;
+    }
+    prev_t = t;
+    prev_z = z;
+  }
+
+  CaseResult r;
+  r.particles = solver.size();
+  r.steps = solver.steps();
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    const double ref = martin_moyce(samples[s]);
+    char key[48];
+    std::snprintf(key, sizeof key, "front_Z/a_at_T*=%.3f", samples[s]);
+    r.metrics.push_back({key, {measured[s], ref, std::abs(measured[s] - ref) / ref, prm["gate"]}});
+  }
+  return r;
+}
+
+}  // namespace
+
+ValidationCase dam_break_case() {
+  return {"dam-break", "collapse of a 1 x 2 water column: surge front vs Martin & Moyce (1952), gate 10 % for T* in [1, 3]",
+          20, params, run};
+}
+
+}  // namespace thaw

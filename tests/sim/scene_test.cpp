@@ -1,0 +1,497 @@
+#include "sim/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "sim/error.h"
+
+namespace thaw {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSource = THAW_SOURCE_DIR;
+
+Json base_scene() {
+  return Json::parse(R"({
+    "name": "test",
+    "domain": {"min": [0, 0, 0], "max": [0.4, 0.2, 0.3], "walls": ["-x", "+x", "-z"], "wall_material": "glass"},
+    "spacing": 0.01,
+    "materials": {
+      "water": {"kind": "fluid", "density": 1000, "viscosity": 1e-3},
+      "glass": {"kind": "solid", "density": 2500}
+    },
+    "fluids": [
+      {"material": "water", "box": {"min": [0, 0, 0], "max": [0.1, 0.1, 0.1]}},
+      {"material": "water", "box": {"min": [0.2, 0, 0], "max": [0.3, 0.1, 0.1]}, "velocity": [1, 0, 0]}
+    ],
+    "solids": [
+      {"shape": "box", "material": "glass", "box": {"min": [0.15, 0, 0], "max": [0.18, 0.2, 0.05]}},
+      {"shape": "plane", "material": "glass", "point": [0, 0, 0], "normal": [0, 0, 2]}
+    ]
+  })");
+}
+
+// The SceneError a broken scene gives; fails the test when it loads.
+SceneError scene_error(Json doc, const std::vector<std::string>& overrides = {}) {
+  try {
+    scene_from_json(std::move(doc), overrides);
+  } catch (const SceneError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "scene loaded without error";
+  return SceneError("", "no error");
+}
+
+// The SceneError one `--set` assignment gives on the base scene.
+SceneError override_error(const std::string& assignment) { return scene_error(base_scene(), {assignment}); }
+
+std::string message(const std::exception& e) { return e.what(); }
+
+fs::path write_temp(const std::string& name, const std::string& text) {
+  const fs::path p = fs::temp_directory_path() / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+// ---- shipped scenes --------------------------------------------------------------------------------
+
+TEST(Scene, EveryShippedConfigLoads) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(kSource / "configs")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW({
+      const Scene s = load_scene(entry.path().string());
+      EXPECT_FALSE(s.name.empty());
+      EXPECT_FALSE(s.fluids.empty());
+    });
+    ++count;
+  }
+  EXPECT_GE(count, 4);
+}
+
+TEST(Scene, DefaultSceneResolvesByName) {
+  const Scene s = load_scene("default");
+  EXPECT_EQ(s.name, "default");
+  ASSERT_EQ(s.fluids.size(), 1u);
+  const Eigen::Vector3d extent = s.fluids[0].box.max - s.fluids[0].box.min;
+  const double particles = (extent / s.spacing).prod();
+  EXPECT_GT(particles, 20e3);
+  EXPECT_LT(particles, 40e3);
+  ASSERT_EQ(s.solids.size(), 1u);
+  EXPECT_EQ(s.materials[static_cast<std::size_t>(s.solids[0].material)].name, "steel");
+  EXPECT_NO_THROW(load_scene("dam-break.json"));
+  EXPECT_NO_THROW(load_scene((kSource / "configs" / "water-drop.json").string()));
+}
+
+TEST(Scene, DocumentedExampleLoads) {
+  const Scene s = scene_from_json(Json::parse(scene_example_json()));
+  EXPECT_EQ(s.solver.kernel, "wendland_c2");
+}
+
+TEST(Scene, DocsAreGeneratedFromTheSchema) {
+  const fs::path doc = kSource / "docs" / "SCENES.md";
+  const std::string generated = scene_reference_markdown();
+  const char* update = std::getenv("THAW_UPDATE_DOCS");
+  if (update != nullptr && std::string(update) == "1") {
+    std::ofstream(doc, std::ios::binary) << generated;
+  }
+  std::ifstream in(doc, std::ios::binary);
+  std::stringstream current;
+  current << in.rdbuf();
+  EXPECT_EQ(current.str(), generated)
+      << doc.string()
+      << " is out of date with the scene schema; regenerate it with\n"
+         "  THAW_UPDATE_DOCS=1 ./thaw_tests --gtest_filter=Scene.DocsAreGeneratedFromTheSchema";
+}
+
+// ---- conversion and defaults -----------------------------------------------------------------------
+
+TEST(Scene, DefaultsAreFilledIn) {
+  const Scene s = scene_from_json(base_scene());
+  EXPECT_EQ(s.solver.cfl, 0.4);
+  EXPECT_EQ(s.solver.kernel, "cubic_spline");
+  EXPECT_EQ(s.solver.sort_every, 1);
+  EXPECT_EQ(s.solver.boundary_volume, "lattice");
+  EXPECT_EQ(s.gravity, Eigen::Vector3d(0, 0, -9.81));
+  EXPECT_EQ(s.wall_layers, 0);
+  EXPECT_EQ(s.fluids[0].velocity, Eigen::Vector3d(0, 0, 0));
+  EXPECT_EQ(s.source["solver"]["cfl"], 0.4);
+  EXPECT_EQ(s.source["description"], "");
+  EXPECT_EQ(s.source["materials"]["glass"]["viscosity"], 0.0);
+}
+
+TEST(Scene, ConvertsEveryField) {
+  const Scene s = scene_from_json(base_scene());
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].name, "water");  // document order
+  EXPECT_EQ(s.materials[1].kind, "solid");
+  EXPECT_EQ(s.materials[1].density, 2500.0);
+  EXPECT_EQ(s.wall_material, 1);
+  EXPECT_EQ(s.walls, (std::vector<std::string>{"-x", "+x", "-z"}));
+  EXPECT_EQ(s.fluids[1].material, 0);
+  EXPECT_EQ(s.fluids[1].velocity, Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(s.fluids[1].box.min, Eigen::Vector3d(0.2, 0, 0));
+  ASSERT_EQ(s.solids.size(), 2u);
+  EXPECT_EQ(s.solids[0].shape, Solid::Shape::Box);
+  EXPECT_EQ(s.solids[0].box.max, Eigen::Vector3d(0.18, 0.2, 0.05));
+  EXPECT_EQ(s.solids[1].shape, Solid::Shape::Plane);
+  EXPECT_EQ(s.solids[1].normal, Eigen::Vector3d(0, 0, 1));  // normalised
+  EXPECT_EQ(s.domain.max, Eigen::Vector3d(0.4, 0.2, 0.3));
+}
+
+TEST(Scene, NoWallsNeedNoWallMaterial) {
+  Json doc = base_scene();
+  doc["domain"].erase("wall_material");
+  doc["domain"]["walls"] = Json::array();
+  EXPECT_EQ(scene_from_json(doc).wall_material, -1);
+}
+
+TEST(Scene, WholeNumberAcceptedAsInteger) {
+  const Scene s = scene_from_json(base_scene(), {"solver.sort_every=4.0"});
+  EXPECT_EQ(s.solver.sort_every, 4);
+  EXPECT_TRUE(s.source["solver"]["sort_every"].is_number_integer());
+}
+
+// ---- overrides -----------------------------------------------------------------------------------------
+
+TEST(SceneOverride, SetsNumbersArraysAndBareStrings) {
+  const Scene s = scene_from_json(
+      base_scene(), {"solver.cfl=0.3", "fluids[0].box.max=[0.05, 0.05, 0.05]", "fluids.1.velocity=[0,0,-1]",
+                     "gravity[2]=-1.62", "solver.kernel=wendland_c2"});
+  EXPECT_EQ(s.solver.cfl, 0.3);
+  EXPECT_EQ(s.fluids[0].box.max, Eigen::Vector3d(0.05, 0.05, 0.05));
+  EXPECT_EQ(s.fluids[1].velocity, Eigen::Vector3d(0, 0, -1));
+  EXPECT_EQ(s.gravity.z(), -1.62);
+  EXPECT_EQ(s.solver.kernel, "wendland_c2");
+}
+
+TEST(SceneOverride, CreatesMissingSectionsThenValidates) {
+  Json doc = base_scene();
+  doc.erase("solids");
+  const Scene s = scene_from_json(doc, {"solver.max_dt=0.002"});
+  EXPECT_EQ(s.solver.max_dt, 0.002);
+}
+
+TEST(SceneOverride, UnknownPathIsReportedAtItsPath) {
+  const SceneError e = override_error("nope.x=1");
+  EXPECT_EQ(e.path(), "nope");
+  EXPECT_NE(message(e).find("unknown key"), std::string::npos) << e.what();
+  EXPECT_EQ(override_error("solver.cfll=0.3").path(), "solver.cfll");
+}
+
+TEST(SceneOverride, IndexPastTheEnd) {
+  const SceneError e = override_error("fluids[5].box.max=[1,1,1]");
+  EXPECT_EQ(e.path(), "fluids[5]");
+  EXPECT_NE(message(e).find("past the end"), std::string::npos) << e.what();
+}
+
+TEST(SceneOverride, IndexIntoAScalar) {
+  const SceneError e = override_error("spacing.x=1");
+  EXPECT_EQ(e.path(), "spacing");
+  EXPECT_NE(message(e).find("is a number"), std::string::npos) << e.what();
+  EXPECT_EQ(override_error("solver[0]=1").path(), "solver");
+}
+
+TEST(SceneOverride, MissingEqualsIsAnError) {
+  Json doc = base_scene();
+  try {
+    apply_override(doc, "solver.cfl");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(message(e).find("PATH=VALUE"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneOverride, BadPathSyntax) {
+  for (const char* path : {"solver..cfl=1", "fluids[x]=1", "fluids[0=1", "[0]=1", "solver.=1"}) {
+    EXPECT_THROW(scene_from_json(base_scene(), {path}), SceneError) << path;
+  }
+}
+
+TEST(SceneOverride, HugeNumberIsOutOfRange) {
+  const SceneError e = override_error("spacing=1e400");
+  EXPECT_EQ(e.path(), "spacing");
+  EXPECT_NE(message(e).find("out of range"), std::string::npos) << e.what();
+}
+
+// ---- errors with paths -------------------------------------------------------------------------------
+
+TEST(SceneError, UnknownTopLevelKeySuggestsTheClosest) {
+  Json doc = base_scene();
+  doc["spacng"] = 0.01;
+  const SceneError e = scene_error(doc);
+  EXPECT_EQ(e.path(), "spacng");
+  EXPECT_NE(message(e).find("did you mean 'spacing'?"), std::string::npos) << e.what();
+  EXPECT_NE(message(e).find("allowed keys: name, description, domain"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, UnknownNestedKeys) {
+  Json doc = base_scene();
+  doc["solver"] = {{"cfll", 0.3}};
+  SceneError e = scene_error(doc);
+  EXPECT_EQ(e.path(), "solver.cfll");
+  EXPECT_NE(message(e).find("did you mean 'cfl'?"), std::string::npos) << e.what();
+
+  doc = base_scene();
+  doc["fluids"][0]["bx"] = doc["fluids"][0]["box"];
+  doc["fluids"][0].erase("box");
+  e = scene_error(doc);
+  EXPECT_EQ(e.path(), "fluids[0].bx");
+  EXPECT_NE(message(e).find("did you mean 'box'?"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, NoSuggestionForAFarOffKey) {
+  const SceneError e = override_error("solver.zebra=1");
+  EXPECT_EQ(message(e).find("did you mean"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, WrongType) {
+  const SceneError e = override_error("spacing=abc");
+  EXPECT_EQ(e.path(), "spacing");
+  EXPECT_NE(message(e).find("expected number, got string \"abc\""), std::string::npos) << e.what();
+  EXPECT_EQ(override_error("gravity=[0, 0]").path(), "gravity");
+  EXPECT_EQ(override_error("gravity=[0, \"a\", 0]").path(), "gravity[1]");
+  EXPECT_EQ(override_error("materials=[]").path(), "materials");
+  EXPECT_EQ(override_error("solver.sort_every=2.5").path(), "solver.sort_every");
+}
+
+TEST(SceneError, NegativeSpacing) {
+  const SceneError e = override_error("spacing=-0.01");
+  EXPECT_EQ(e.path(), "spacing");
+  EXPECT_NE(message(e).find("-0.01 m is out of range: must be > 0 m"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, CflOutOfRange) {
+  const SceneError e = override_error("solver.cfl=1.5");
+  EXPECT_EQ(e.path(), "solver.cfl");
+  EXPECT_NE(message(e).find("1.5 is out of range: must be in (0, 1]"), std::string::npos) << e.what();
+  EXPECT_EQ(override_error("solver.cfl=0").path(), "solver.cfl");
+  EXPECT_NO_THROW(scene_from_json(base_scene(), {"solver.cfl=1"}));
+}
+
+TEST(SceneError, NonFiniteNumber) {
+  Json doc = base_scene();
+  doc["spacing"] = std::nan("");
+  SceneError e = scene_error(doc);
+  EXPECT_EQ(e.path(), "spacing");
+  EXPECT_NE(message(e).find("finite"), std::string::npos) << e.what();
+  doc = base_scene();
+  doc["gravity"] = {0.0, 0.0, INFINITY};
+  EXPECT_EQ(scene_error(doc).path(), "gravity[2]");
+}
+
+TEST(SceneError, MissingRequiredKey) {
+  Json doc = base_scene();
+  doc.erase("spacing");
+  EXPECT_EQ(scene_error(doc).path(), "spacing");
+  doc = base_scene();
+  doc["domain"].erase("max");
+  EXPECT_EQ(scene_error(doc).path(), "domain.max");
+  doc = base_scene();
+  doc.erase("domain");
+  EXPECT_EQ(scene_error(doc).path(), "domain");
+}
+
+TEST(SceneError, EmptyArraysAndBadNames) {
+  EXPECT_EQ(override_error("fluids=[]").path(), "fluids");
+  EXPECT_EQ(override_error("materials={}").path(), "materials");
+  Json doc = base_scene();
+  doc["materials"]["wa ter"] = doc["materials"]["water"];
+  EXPECT_EQ(scene_error(doc).path(), "materials.wa ter");
+}
+
+TEST(SceneError, EnumWithTypo) {
+  const SceneError e = override_error("solver.kernel=cubic_splin");
+  EXPECT_EQ(e.path(), "solver.kernel");
+  EXPECT_NE(message(e).find("did you mean 'cubic_spline'?"), std::string::npos) << e.what();
+  EXPECT_EQ(override_error("domain.walls=[\"-x\", \"x\"]").path(), "domain.walls[1]");
+  EXPECT_EQ(override_error("domain.walls=[\"-x\", \"-x\"]").path(), "domain.walls[1]");
+}
+
+TEST(SceneError, EmptyDomain) {
+  const SceneError e = override_error("domain.max=[0.4, 0, 0.3]");
+  EXPECT_EQ(e.path(), "domain");
+  EXPECT_NE(message(e).find("empty domain"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, EmptyBox) {
+  const SceneError e = override_error("solids[0].box.max=[0.1, 0.2, 0.05]");
+  EXPECT_EQ(e.path(), "solids[0].box");
+  EXPECT_NE(message(e).find("x runs from 0.15 m to 0.1 m"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, UnknownMaterial) {
+  const SceneError e = override_error("fluids[1].material=lava");
+  EXPECT_EQ(e.path(), "fluids[1].material");
+  EXPECT_NE(message(e).find("unknown material 'lava'; defined: water, glass"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, SolidMaterialForAFluid) {
+  const SceneError e = override_error("fluids[0].material=glass");
+  EXPECT_EQ(e.path(), "fluids[0].material");
+  EXPECT_NE(message(e).find("'glass' is a solid"), std::string::npos) << e.what();
+  EXPECT_EQ(override_error("solids[1].material=water").path(), "solids[1].material");
+  EXPECT_EQ(override_error("domain.wall_material=water").path(), "domain.wall_material");
+}
+
+TEST(SceneError, WallsNeedAMaterial) {
+  Json doc = base_scene();
+  doc["domain"].erase("wall_material");
+  EXPECT_EQ(scene_error(doc).path(), "domain.wall_material");
+}
+
+TEST(SceneError, ShapeDecidesWhichFieldsBelong) {
+  Json doc = base_scene();
+  doc["solids"][1]["box"] = doc["solids"][0]["box"];
+  SceneError e = scene_error(doc);
+  EXPECT_EQ(e.path(), "solids[1].box");
+  EXPECT_NE(message(e).find("only allowed when shape is 'box'"), std::string::npos) << e.what();
+  doc = base_scene();
+  doc["solids"][1].erase("normal");
+  e = scene_error(doc);
+  EXPECT_EQ(e.path(), "solids[1].normal");
+  EXPECT_NE(message(e).find("required when shape is 'plane'"), std::string::npos) << e.what();
+  EXPECT_EQ(override_error("solids[1].normal=[0,0,0]").path(), "solids[1].normal");
+}
+
+TEST(SceneError, FluidOutsideTheDomain) {
+  const SceneError e = override_error("fluids[1].box.max=[0.5, 0.1, 0.1]");
+  EXPECT_EQ(e.path(), "fluids[1].box");
+  EXPECT_NE(message(e).find("outside the domain along x"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, SpacingAgainstTheDomain) {
+  EXPECT_EQ(override_error("spacing=0.2").path(), "spacing");
+  const SceneError e = override_error("spacing=0.0001");
+  EXPECT_EQ(e.path(), "spacing");
+  EXPECT_NE(message(e).find("more than the limit of 20,000,000"), std::string::npos) << e.what();
+}
+
+TEST(SceneError, TimeStepLimitsInOrder) {
+  EXPECT_EQ(override_error("solver.min_dt=0.01").path(), "solver.min_dt");
+}
+
+// ---- files -------------------------------------------------------------------------------------------
+
+TEST(SceneFile, MissingFileNamesItAndWhereItLooked) {
+  try {
+    load_scene("no-such-scene");
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    ADD_FAILURE() << "a missing file has no JSON path: " << e.what();
+  } catch (const Error& e) {
+    EXPECT_NE(message(e).find("'no-such-scene' not found"), std::string::npos) << e.what();
+    EXPECT_NE(message(e).find("configs/no-such-scene.json"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneFile, InvalidJsonGivesLineAndColumn) {
+  const fs::path p = write_temp("thaw-bad-scene.json", "{\n  \"spacing\": 0.01,\n  \"domain\": }\n");
+  try {
+    load_scene(p.string());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(message(e).find(p.string() + ":3:13: invalid JSON"), std::string::npos) << e.what();
+  }
+  fs::remove(p);
+}
+
+TEST(SceneFile, HugeNumberInAFile) {
+  const fs::path p = write_temp("thaw-huge-scene.json", "{\n  \"spacing\": 1e400\n}\n");
+  try {
+    load_scene(p.string());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(message(e).find(p.string() + ":2:14: invalid JSON: number 1e400 is out of range"),
+              std::string::npos)
+        << e.what();
+  }
+  fs::remove(p);
+}
+
+TEST(SceneFile, CommentsAndFileNameAsDefaultName) {
+  Json doc = base_scene();
+  doc.erase("name");
+  const fs::path p = write_temp("thaw-commented.json", "// a comment\n" + doc.dump(2));
+  const Scene s = load_scene(p.string(), {"solver.cfl=0.2"});
+  EXPECT_EQ(s.name, "thaw-commented");
+  EXPECT_EQ(s.solver.cfl, 0.2);
+  fs::remove(p);
+}
+
+// ---- the schema as building blocks for validation cases -------------------------------------------
+
+TEST(Schema, ACaseDeclaresItsOwnParametersAndEmbedsTheSolver) {
+  const Field params = object("", {
+                                      number("length", "Bar length").in("m").def(1.0).above(0),
+                                      integer("samples", "Probe count").at_least(2),
+                                      solver_schema(),
+                                  });
+  Json doc = {{"samples", 8}, {"solver", {{"cfl", 0.2}}}};
+  validate(doc, params);
+  EXPECT_EQ(doc["length"], 1.0);
+  EXPECT_EQ(solver_settings_from_json(doc["solver"]).cfl, 0.2);
+  EXPECT_EQ(solver_settings_from_json(doc["solver"]).eos, "tait");
+
+  Json bad = {{"samples", 1}};
+  try {
+    validate(bad, params, "case");
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path(), "case.samples");
+  }
+  EXPECT_NE(schema_markdown(params, "Parameters").find("| `length` | number | m | `1` | > 0 |"),
+            std::string::npos);
+}
+
+TEST(Schema, VariantDefaultsOnlyForTheirVariant) {
+  const Field params =
+      object("", {
+                     choice("source", {"lamp", "dryer"}, "Heat source"),
+                     number("power", "Lamp power").in("W").def(60.0).when("source", "lamp"),
+                     number("flow", "Dryer air flow").in("m^3/s").def(0.01).when("source", "dryer"),
+                 });
+  Json lamp = {{"source", "lamp"}};
+  validate(lamp, params);
+  EXPECT_EQ(lamp, (Json{{"source", "lamp"}, {"power", 60.0}}));
+  Json dryer = {{"source", "dryer"}, {"power", 100}};
+  try {
+    validate(dryer, params);
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path(), "power");
+  }
+}
+
+TEST(Schema, FindsDeclarationsAndLiveParameters) {
+  const Field* cfl = find_field(scene_schema(), "solver.cfl");
+  ASSERT_NE(cfl, nullptr);
+  EXPECT_TRUE(cfl->settable);
+  EXPECT_EQ(range_text(*cfl), "(0, 1]");
+  const Field* density = find_field(scene_schema(), "materials.water.density");
+  ASSERT_NE(density, nullptr);
+  EXPECT_EQ(density->unit, "kg/m^3");
+  ASSERT_NE(find_field(scene_schema(), "fluids[0].box.min"), nullptr);
+  EXPECT_EQ(find_field(scene_schema(), "solver.nope"), nullptr);
+  const std::vector<std::string> live = settable_paths(scene_schema());
+  EXPECT_NE(std::find(live.begin(), live.end(), "solver.cfl"), live.end());
+  EXPECT_NE(std::find(live.begin(), live.end(), "gravity"), live.end());
+}
+
+TEST(Schema, ValidatesASingleValueAgainstItsField) {
+  const Field& cfl = *find_field(scene_schema(), "solver.cfl");
+  Json ok = 0.5;
+  EXPECT_NO_THROW(validate(ok, cfl, "solver.cfl"));
+  Json too_big = 2.0;
+  EXPECT_THROW(validate(too_big, cfl, "solver.cfl"), SceneError);
+}
+
+}  // namespace
+}  // namespace thaw
