@@ -185,7 +185,7 @@ constexpr const char* kExample = R"({
   "domain": {"min": [0, 0, 0], "max": [0.6, 0.2, 0.4], "walls": ["-x", "+x", "-y", "+y", "-z"],
              "wall_material": "glass"},
   "spacing": 0.01,
-  "solver": {"kernel": "wendland_c2", "cfl": 0.3},
+  "solver": {"kernel": "wendland_c2", "support_ratio": 3.0, "cfl": 0.3},
   "materials": {
     "water": {"kind": "fluid", "density": 1000, "viscosity": 1.0e-3},
     "glass": {"kind": "solid", "density": 2500},

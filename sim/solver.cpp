@@ -104,7 +104,9 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     lo = lo.cwiseMin(Eigen::Vector3f(x[0], x[1], x[2]));
     hi = hi.cwiseMax(Eigen::Vector3f(x[0], x[1], x[2]));
   }
-  grid_.cell = k_.support / float(kGridReach);
+  // A few ulps above H / reach, so float rounding in grid_cell() never puts a neighbour just inside
+  // the support more than `reach` cells away.
+  grid_.cell = k_.support / float(kGridReach) * (1.0f + 8.0f * std::numeric_limits<float>::epsilon());
   grid_.reach = kGridReach;
   grid_.origin = lo - Eigen::Vector3f::Constant(grid_.cell);
   const Eigen::Vector3f ext = hi + Eigen::Vector3f::Constant(grid_.cell) - grid_.origin;
@@ -373,13 +375,14 @@ double Solver::choose_time_step() {
   double vmax2 = 0, amax2 = 0;
   std::uint32_t fastest = 0, bad = 0xffffffffu;
   if (n_ > 0) {
-    k_limits_.setArg(0, velocity_);
-    k_limits_.setArg(1, accel_);
-    k_limits_.setArg(2, phase_);
-    k_limits_.setArg(3, limits_f_);
-    k_limits_.setArg(4, limits_i_);
-    k_limits_.setArg(5, static_cast<cl_uint>(n_));
-    k_limits_.setArg(6, tile_);
+    k_limits_.setArg(0, position_);
+    k_limits_.setArg(1, velocity_);
+    k_limits_.setArg(2, accel_);
+    k_limits_.setArg(3, phase_);
+    k_limits_.setArg(4, limits_f_);
+    k_limits_.setArg(5, limits_i_);
+    k_limits_.setArg(6, static_cast<cl_uint>(n_));
+    k_limits_.setArg(7, tile_);
     cl_.queue().enqueueNDRangeKernel(k_limits_, cl::NullRange, global_for(ntiles_));
     std::vector<cl_float2> f(ntiles_);
     std::vector<cl_uint2> ix(ntiles_);
@@ -411,8 +414,12 @@ double Solver::choose_time_step() {
     return os.str();
   };
   const char* advice = "; lower solver.max_dt or solver.cfl, or raise solver.sound_speed_factor";
-  if (bad != 0xffffffffu)
-    throw BlowUpError(where() + particle_at(bad) + " has a non-finite velocity or acceleration" + advice);
+  if (bad != 0xffffffffu) {
+    const bool accel_only = (bad & 0x80000000u) != 0;
+    throw BlowUpError(where() + particle_at(bad & 0x7fffffffu) +
+                      (accel_only ? " has a non-finite acceleration" : " has a non-finite position or velocity") +
+                      advice);
+  }
   const double vmax = std::sqrt(vmax2);
   if (vmax > k_.max_speed) {
     std::ostringstream os;

@@ -1,15 +1,11 @@
 /* Summation density rho_i = sum_j m_j W_ij over fluid and boundary neighbours (boundary m_j = Psi_j,
- * Akinci 2012 eq. 6), then the equation of state. state_i = (rho, p / rho^2, is_boundary, p). */
+ * Akinci 2012 eq. 6), then the equation of state; boundary particles too, which gives the walls the
+ * pressure the fluid presses on them with (see forces.cl). state_i = (rho, p / rho^2, is_boundary, p). */
 kernel void density(global const float4* pos, global const uchar* phase, global const uint* cell_start,
                     const Grid g, const float H, const float rho0, const float B, const float gamma_eos,
                     global float* density, global float4* state, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
-  if (phase[i] == THAW_PHASE_SOLID) {
-    density[i] = rho0;
-    state[i] = (float4)(rho0, 0.0f, 1.0f, 0.0f);
-    return;
-  }
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
@@ -31,5 +27,5 @@ kernel void density(global const float4* pos, global const uchar* phase, global 
   /* No tension: clamping keeps free-surface particles from clumping (tensile instability). */
   p = fmax(p, 0.0f);
   density[i] = rho;
-  state[i] = (float4)(rho, p / (rho * rho), 0.0f, p);
+  state[i] = (float4)(rho, p / (rho * rho), phase[i] == THAW_PHASE_SOLID ? 1.0f : 0.0f, p);
 }

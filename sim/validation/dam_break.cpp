@@ -11,6 +11,7 @@
 #include "sim/metrics.h"
 #include "sim/solver.h"
 #include "sim/validation/case.h"
+#include "sim/validation/hydrostatic_profile.h"
 
 namespace thaw {
 namespace {
@@ -74,7 +75,10 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   samples.push_back(t_hi);
   const double t_scale = 1.0 / std::sqrt(2.0 * g / a);  // t = T* t_scale
 
-  Solver solver(cl, scene, initial_state(scene));
+  // The column starts at rest on its hydrostatic profile, as behind the gate.
+  SimState start = initial_state(scene);
+  compress_to_hydrostatic(start.particles, hydrostatic_profile(scene, Hc));
+  Solver solver(cl, scene, start);
   solver.warm_up();
   const auto t0 = std::chrono::steady_clock::now();
   auto front = [&] {

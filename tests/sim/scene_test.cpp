@@ -164,7 +164,7 @@ TEST(Scene, WholeNumberAcceptedAsInteger) {
 TEST(SceneOverride, SetsNumbersArraysAndBareStrings) {
   const Scene s = scene_from_json(
       base_scene(), {"solver.cfl=0.3", "fluids[0].box.max=[0.05, 0.05, 0.05]", "fluids.1.velocity=[0,0,-1]",
-                     "gravity[2]=-1.62", "solver.kernel=wendland_c2"});
+                     "gravity[2]=-1.62", "solver.kernel=wendland_c2", "solver.support_ratio=3"});
   EXPECT_EQ(s.solver.cfl, 0.3);
   EXPECT_EQ(s.fluids[0].box.max, Eigen::Vector3d(0.05, 0.05, 0.05));
   EXPECT_EQ(s.fluids[1].velocity, Eigen::Vector3d(0, 0, -1));
@@ -494,4 +494,16 @@ TEST(Schema, ValidatesASingleValueAgainstItsField) {
 }
 
 }  // namespace
+}  // namespace thaw
+
+namespace thaw {
+TEST(Scene, WendlandNeedsAWideEnoughSupport) {
+  try {
+    scene_from_json(Json::parse(scene_example_json()), {"solver.support_ratio=2"});
+    FAIL() << "expected a SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path(), "solver.support_ratio");
+    EXPECT_NE(std::string(e.what()).find("wendland_c2"), std::string::npos) << e.what();
+  }
+}
 }  // namespace thaw

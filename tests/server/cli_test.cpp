@@ -1,0 +1,194 @@
+// The `thaw` executable end to end: bad scenes fail cleanly (exit status 2, no crash, the JSON path
+// named), the subcommands' listings and errors, a short run's metrics and exports, and scene-doc.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "sim/scene.h"
+#include "tests/test_support.h"
+
+namespace thaw {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CommandResult;
+using testing::run_thaw;
+using testing::shell_quote;
+using testing::TempDir;
+
+// A valid scene (a few hundred particles) that each bad-scene test breaks in one place.
+Json small_scene() {
+  return Json::parse(R"({
+    "name": "cli-test",
+    "domain": {"min": [0, 0, 0], "max": [0.2, 0.1, 0.2], "walls": ["-z"], "wall_material": "glass"},
+    "spacing": 0.02,
+    "materials": {
+      "water": {"kind": "fluid", "density": 1000, "viscosity": 1e-3},
+      "glass": {"kind": "solid", "density": 2500}
+    },
+    "fluids": [{"material": "water", "box": {"min": [0, 0, 0], "max": [0.1, 0.1, 0.1]}}]
+  })");
+}
+
+std::string describe(const CommandResult& r) {
+  return "exited " + std::to_string(r.exited) + " code " + std::to_string(r.exit_code) + " signal " +
+         std::to_string(r.signal) + "\nstdout: " + r.out + "\nstderr: " + r.err;
+}
+
+// Runs `thaw run` on `doc` written to a file and expects a clean failure whose message names `path`.
+void expect_scene_rejected(const Json& doc, const std::string& path, const std::string& extra = "") {
+  TempDir dir("cli-bad-scene");
+  testing::write_text(dir / "scene.json", doc.dump(2));
+  const auto r = run_thaw("run " + shell_quote(dir / "scene.json") + " --steps 1 " + extra, dir);
+  EXPECT_TRUE(r.exited) << "killed by signal " << r.signal << "\n" << describe(r);
+  EXPECT_EQ(r.exit_code, 2) << describe(r);
+  EXPECT_NE(r.err.find(path), std::string::npos) << "stderr should name '" << path << "'\n" << describe(r);
+  EXPECT_EQ(r.err.find("terminate called"), std::string::npos) << describe(r);
+}
+
+TEST(ThawCli, UnknownKeyIsRejectedWithItsPath) {
+  Json doc = small_scene();
+  doc["solver"] = {{"cfll", 0.3}};
+  expect_scene_rejected(doc, "solver.cfll");
+}
+
+TEST(ThawCli, WrongTypeIsRejectedWithItsPath) {
+  Json doc = small_scene();
+  doc["spacing"] = "abc";
+  expect_scene_rejected(doc, "spacing");
+}
+
+TEST(ThawCli, NegativeSpacingIsRejected) {
+  Json doc = small_scene();
+  doc["spacing"] = -0.01;
+  expect_scene_rejected(doc, "spacing");
+}
+
+TEST(ThawCli, EmptyDomainIsRejected) {
+  Json doc = small_scene();
+  doc["domain"]["max"] = doc["domain"]["min"];
+  expect_scene_rejected(doc, "domain");
+}
+
+TEST(ThawCli, SetOverrideOutOfRangeOnShippedSceneIsRejected) {
+  TempDir dir("cli-set");
+  const auto r = run_thaw("run dam-break --steps 1 --set spacing=-1", dir);
+  EXPECT_TRUE(r.exited && r.exit_code == 2) << describe(r);
+  EXPECT_NE(r.err.find("spacing"), std::string::npos) << describe(r);
+  EXPECT_TRUE(r.out.find("particles") == std::string::npos) << "the run must not start\n" << describe(r);
+}
+
+TEST(ThawCli, MissingSceneFileIsNamed) {
+  TempDir dir("cli-missing");
+  const std::string missing = dir / "no-such-scene.json";
+  const auto r = run_thaw("run " + shell_quote(missing) + " --steps 1", dir);
+  EXPECT_TRUE(r.exited && r.exit_code == 2) << describe(r);
+  EXPECT_NE(r.err.find(missing), std::string::npos) << describe(r);
+}
+
+TEST(ThawCli, ValidateListsTheCases) {
+  TempDir dir("cli-validate");
+  const auto r = run_thaw("validate --list", dir);
+  EXPECT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  EXPECT_NE(r.out.find("hydrostatic"), std::string::npos) << describe(r);
+  EXPECT_NE(r.out.find("dam-break"), std::string::npos) << describe(r);
+}
+
+TEST(ThawCli, UnknownValidationCaseNamesTheCases) {
+  TempDir dir("cli-validate-nope");
+  const auto r = run_thaw("validate nope", dir);
+  EXPECT_TRUE(r.exited) << describe(r);
+  EXPECT_NE(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("nope"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("hydrostatic"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("dam-break"), std::string::npos) << describe(r);
+}
+
+TEST(ThawCli, InfoNamesADevice) {
+  TempDir dir("cli-info");
+  const auto r = run_thaw("info", dir);
+  EXPECT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  const auto at = r.out.find("would use: ");
+  ASSERT_NE(at, std::string::npos) << describe(r);
+  EXPECT_NE(r.out.compare(at, 16, "would use: none:"), 0) << describe(r);
+}
+
+TEST(ThawCli, RunWithoutUntilOrStepsSaysSo) {
+  TempDir dir("cli-run-no-end");
+  const auto r = run_thaw("run dam-break", dir);
+  EXPECT_TRUE(r.exited && r.exit_code == 2) << describe(r);
+  EXPECT_NE(r.err.find("--until"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("--steps"), std::string::npos) << describe(r);
+}
+
+TEST(ThawCli, ShortRunWritesMetricsAndExports) {
+  TempDir dir("cli-run");
+  const double interval = 0.001;
+  const auto r = run_thaw(
+      "run dam-break --steps 5 --set spacing=0.03 --set solver.output_interval=0.001 "
+      "--metrics m.jsonl --export out --every 2 --no-progress",
+      dir);
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+
+  std::ifstream in(dir / "m.jsonl");
+  std::vector<Json> lines;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    ASSERT_NO_THROW(lines.push_back(Json::parse(line))) << line;
+  }
+  ASSERT_GE(lines.size(), 2u);
+  for (const auto& j : lines)
+    for (const char* key : {"time", "steps", "dt", "wall_ms_per_step", "particles", "max_speed",
+                            "max_density_error", "total_mass", "energy"})
+      EXPECT_TRUE(j.contains(key)) << "missing '" << key << "' in " << j.dump();
+  EXPECT_EQ(lines.front()["steps"].get<int>(), 0);
+  EXPECT_EQ(lines.front()["time"].get<double>(), 0.0);
+  EXPECT_EQ(lines.back()["steps"].get<int>(), 5);
+  EXPECT_GT(lines.back()["total_mass"].get<double>(), 0.0);
+  // One line at the first step past each output boundary, plus the start and the final partial one.
+  const double end = lines.back()["time"].get<double>();
+  const double dt = lines.back()["dt"].get<double>();
+  ASSERT_GT(dt, 0.0);
+  const int boundaries = static_cast<int>(std::floor(end / interval + 1e-9));
+  ASSERT_GE(boundaries, 1) << "the run should cross an output boundary; end time " << end;
+  for (int k = 1; k <= boundaries; ++k) {
+    int found = 0;
+    for (const auto& j : lines) {
+      const double t = j["time"].get<double>();
+      found += t >= k * interval - 1e-12 && t < k * interval + 1.5 * dt;
+    }
+    EXPECT_EQ(found, 1) << "output boundary " << k * interval << " s";
+  }
+  EXPECT_LE(lines.size(), static_cast<std::size_t>(boundaries) + 2);
+  for (std::size_t i = 1; i < lines.size(); ++i)
+    EXPECT_GT(lines[i]["steps"].get<int>(), lines[i - 1]["steps"].get<int>());
+
+  // Frames at the start and after steps 2 and 4.
+  int vtu = 0, ply = 0, pvd = 0;
+  for (const auto& e : fs::directory_iterator(dir.path() / "out")) {
+    const auto ext = e.path().extension();
+    vtu += ext == ".vtu";
+    ply += ext == ".ply";
+    pvd += ext == ".pvd";
+  }
+  EXPECT_EQ(vtu, 3);
+  EXPECT_EQ(ply, 3);
+  EXPECT_EQ(pvd, 1);
+}
+
+TEST(ThawCli, SceneDocMatchesTheCommittedReference) {
+  TempDir dir("cli-scene-doc");
+  const auto r = run_thaw("scene-doc", dir);
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  const std::string committed = testing::read_file_bytes(fs::path(THAW_SOURCE_DIR) / "docs" / "SCENES.md");
+  ASSERT_FALSE(committed.empty());
+  EXPECT_TRUE(r.out == committed) << "docs/SCENES.md is out of date: regenerate it with `thaw scene-doc`";
+}
+
+}  // namespace
+}  // namespace thaw

@@ -1,0 +1,113 @@
+#pragma once
+// Helpers shared by the tests: one OpenCL runtime per test suite (pocl start-up and kernel builds
+// are the slow part of a test), self-removing temporary directories, whole-file reads, and running
+// the built `thaw` executable with its output and exit status captured.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "sim/cl_runtime.h"
+
+namespace thaw::testing {
+
+namespace fs = std::filesystem;
+
+// Base fixture: `cl()` is one ClRuntime (default device) created when the suite starts.
+class ClSuite : public ::testing::Test {
+ public:
+  static void SetUpTestSuite() {
+    if (!runtime_) runtime_ = std::make_unique<ClRuntime>();
+  }
+  static void TearDownTestSuite() { runtime_.reset(); }
+
+ protected:
+  static ClRuntime& cl() { return *runtime_; }
+
+ private:
+  static inline std::unique_ptr<ClRuntime> runtime_;
+};
+
+// A fresh directory under the system temp directory, removed with everything in it on destruction.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) {
+    static std::atomic<int> counter{0};
+    const auto now = std::chrono::steady_clock::now().time_since_epoch().count();
+    path_ = fs::temp_directory_path() / ("thaw-" + tag + "-" + std::to_string(::getpid()) + "-" +
+                                         std::to_string(counter++) + "-" + std::to_string(now));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const fs::path& path() const { return path_; }
+  std::string operator/(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+inline std::string read_file_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+inline void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+}
+
+// Single-quotes an argument for /bin/sh.
+inline std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+struct CommandResult {
+  bool exited = false;   // ended by exit(), not by a signal
+  int exit_code = -1;    // exit status when `exited`
+  int signal = 0;        // terminating signal otherwise
+  std::string out, err;  // captured stdout and stderr
+};
+
+// Runs THAW_BINARY with `args` (already shell-quoted where needed) in `dir`, capturing both streams.
+inline CommandResult run_thaw(const std::string& args, const TempDir& dir) {
+  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = "cd " + shell_quote(dir.path().string()) + " && " + shell_quote(THAW_BINARY) + " " +
+                          args + " >" + shell_quote(out) + " 2>" + shell_quote(err) + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  CommandResult r;
+  // sh reports a child killed by signal N as exit status 128 + N.
+  if (status != -1 && WIFEXITED(status)) {
+    const int code = WEXITSTATUS(status);
+    if (code > 128 && code < 128 + 64) {
+      r.signal = code - 128;
+    } else {
+      r.exited = true;
+      r.exit_code = code;
+    }
+  } else if (status != -1 && WIFSIGNALED(status)) {
+    r.signal = WTERMSIG(status);
+  }
+  r.out = read_file_bytes(out);
+  r.err = read_file_bytes(err);
+  return r;
+}
+
+}  // namespace thaw::testing
