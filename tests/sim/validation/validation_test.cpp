@@ -1,0 +1,107 @@
+// Validation cases at CI-sized resolution, and the references' own properties.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim/solver.h"
+#include "sim/validation/case.h"
+#include "sim/validation/hydrostatic_profile.h"
+#include "tests/test_support.h"
+
+namespace thaw {
+namespace {
+
+using testing::ClSuite;
+using testing::TempDir;
+using testing::run_thaw;
+
+class Validation : public ClSuite {};
+
+void print(const CaseResult& r) {
+  for (const auto& [key, m] : r.metrics)
+    std::printf("  %-28s value %-12.6g reference %-12.6g error %-10.4g gate %g\n", key.c_str(), m.value, m.reference,
+                m.error, m.gate);
+}
+
+TEST_F(Validation, HydrostaticPassesAtCiResolution) {
+  const CaseResult r = run_validation(cl(), "hydrostatic", 20, {});
+  print(r);
+  EXPECT_TRUE(r.passed());
+  ASSERT_EQ(r.metrics.size(), 4u);
+  for (const auto& [key, m] : r.metrics) EXPECT_LE(m.error, m.gate) << key;
+}
+
+// The reference is computed from the parameters: its bottom pressure is the column's weight per area
+// whatever the gravity, density or stiffness, and it tends to rho0 g (H - z) as the fluid stiffens.
+TEST(HydrostaticReference, WeighsTheColumnAndTendsToTheIncompressibleProfile) {
+  for (double g : {1.62, 9.81, 24.8})
+    for (double B : {1e4, 1e5, 1e7}) {
+      const HydrostaticProfile p{1000.0, g, 0.3, B, 7.0, true};
+      EXPECT_NEAR(p.pressure_at(0.0), 1000.0 * g * 0.3, 1e-9 * 1000.0 * g * 0.3);
+      EXPECT_LE(p.top(), 0.3);
+      EXPECT_EQ(p.pressure_at(p.top() + 1e-9), 0.0);
+      const HydrostaticProfile lin{1000.0, g, 0.3, B * 7.0, 7.0, false};
+      EXPECT_NEAR(lin.pressure_at(0.0), 1000.0 * g * 0.3, 1e-9 * 1000.0 * g * 0.3);
+    }
+  const HydrostaticProfile stiff{1000.0, 9.81, 0.3, 1e12, 7.0, true};
+  for (double z : {0.0, 0.1, 0.2}) EXPECT_NEAR(stiff.pressure_at(z), 1000.0 * 9.81 * (0.3 - z), 1e-3);
+  // A particle whose column above weighs rho0 g (H - z) sits where the profile gives that pressure.
+  const HydrostaticProfile soft{1000.0, 9.81, 0.3, 2e4, 7.0, true};
+  for (double z : {0.01, 0.15, 0.29})
+    EXPECT_NEAR(soft.pressure_at(soft.height_of(z)), 1000.0 * 9.81 * (0.3 - z), 1e-6 * 1000.0 * 9.81 * 0.3);
+}
+
+TEST_F(Validation, HydrostaticReferenceFollowsOverriddenParameters) {
+  // A shorter, lighter column on the Moon: the case still compares against its own exact profile.
+  const CaseResult r = run_validation(cl(), "hydrostatic", 12,
+                                      {"height=0.12", "width=0.1", "gravity=1.62", "density=900", "settle_time=0.6",
+                                       "free_time=0.05", "pressure_gate=1"});
+  print(r);
+  const auto& profile = r.metrics.front().second;
+  // The bottom of the interior sees close to rho0 g H of the overridden parameters.
+  EXPECT_LT(profile.reference, 900.0 * 1.62 * 0.12);
+  EXPECT_GT(profile.reference, 0.0);
+  EXPECT_EQ(r.metrics.back().first, "mass");
+  EXPECT_EQ(r.metrics.back().second.error, 0.0);
+}
+
+// Martin & Moyce's front leads from T* ~ 0.8 in every run here (free-slip or frictional walls,
+// resolutions 20 and 30: see docs/VALIDATION-RESULTS.md): the experiment's gate took time to open.
+// What is asserted is what holds: the front matches the data by T* = 2.5 onwards and never strays far.
+TEST_F(Validation, DamBreakFrontFollowsMartinMoyce) {
+  const CaseResult r = run_validation(cl(), "dam-break", 16, {});
+  print(r);
+  ASSERT_GE(r.metrics.size(), 3u);
+  double previous = 1.0;
+  for (const auto& [key, m] : r.metrics) {
+    EXPECT_TRUE(std::isfinite(m.value)) << key;
+    EXPECT_GT(m.value, previous) << key << ": the front only advances";
+    previous = m.value;
+    EXPECT_LT(m.error, 0.2) << key;
+  }
+  EXPECT_LE(r.metrics.back().second.error, r.metrics.back().second.gate) << r.metrics.back().first;
+}
+
+TEST(ValidateCli, JsonReportHasTheDocumentedShape) {
+  TempDir dir("validate-json");
+  const auto r = run_thaw(
+      "validate hydrostatic --res 8 --set width=0.2 --set interior_margin=1 --set settle_time=0.05 --set free_time=0.01 --json", dir);
+  ASSERT_TRUE(r.exited);
+  const Json j = Json::parse(r.out);
+  EXPECT_EQ(j["case"], "hydrostatic");
+  for (const char* key : {"passed", "particles", "steps", "wall_s", "metrics"}) EXPECT_TRUE(j.contains(key)) << key;
+  for (const auto& [name, m] : j["metrics"].items())
+    for (const char* key : {"value", "reference", "error", "gate"}) EXPECT_TRUE(m.contains(key)) << name << "." << key;
+  EXPECT_EQ(r.exit_code, j["passed"].get<bool>() ? 0 : 1);
+}
+
+TEST(ValidateCli, BadCaseParameterNamesItsPath) {
+  TempDir dir("validate-bad");
+  const auto r = run_thaw("validate hydrostatic --res 8 --set heigth=0.1", dir);
+  ASSERT_TRUE(r.exited);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("heigth"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace thaw
