@@ -128,15 +128,23 @@ std::string ClRuntime::description() const {
 
 cl::Program ClRuntime::build(const std::vector<std::string>& files, const std::string& options) const {
   const auto& embedded = embedded_kernel_files();
-  std::string source;
-  std::string names;
+  std::vector<Source> sources;
   for (const auto& f : files) {
     auto it = embedded.find(f);
     if (it == embedded.end()) throw Error("kernel file sim/kernels/" + f + " is not embedded in this build");
-    source += "#line 1 \"sim/kernels/" + f + "\"\n";
-    source += it->second;
+    sources.emplace_back("sim/kernels/" + f, it->second);
+  }
+  return build_sources(sources, options);
+}
+
+cl::Program ClRuntime::build_sources(const std::vector<Source>& sources, const std::string& options) const {
+  std::string source;
+  std::string names;
+  for (const auto& [name, text] : sources) {
+    source += "#line 1 \"" + name + "\"\n";
+    source += text;
     source += "\n";
-    names += (names.empty() ? "" : ", ") + std::string("sim/kernels/") + f;
+    names += (names.empty() ? "" : ", ") + name;
   }
   cl::Program program(context_, source);
   const std::string opts = "-cl-std=CL1.2 -cl-mad-enable " + options;

@@ -2,6 +2,8 @@
 // The OpenCL device, context and queue, and building programs from the embedded kernel files.
 #include <CL/opencl.hpp>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace thaw {
@@ -32,6 +34,10 @@ class ClRuntime {
   // Builds a program from embedded files (sim/kernels/*), each preceded by a #line directive so the
   // build log names the file and line. Throws Error with the log, naming the files, on failure.
   cl::Program build(const std::vector<std::string>& files, const std::string& options = "") const;
+
+  // The same from (file name, source text) pairs; build() passes the embedded files here.
+  using Source = std::pair<std::string, std::string_view>;
+  cl::Program build_sources(const std::vector<Source>& sources, const std::string& options = "") const;
 
   const DeviceInfo& info() const { return info_; }
   std::string description() const;

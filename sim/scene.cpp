@@ -231,7 +231,6 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.min_dt = j["min_dt"].get<double>();
   s.max_speed = j["max_speed"].get<double>();
   s.output_interval = j["output_interval"].get<double>();
-  s.sort_every = j["sort_every"].get<int>();
   return s;
 }
 

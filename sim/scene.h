@@ -55,7 +55,6 @@ struct SolverSettings {
   double min_dt = 1e-8;                 // [s] below this the run stops as blown up
   double max_speed = 0.0;               // [m/s]; 0 = 5 * c; faster particles stop the run as blown up
   double output_interval = 0.01;        // [s] metrics / export cadence in sim time
-  int sort_every = 1;                   // re-sort the neighbour grid every k steps
 };
 
 struct Scene {

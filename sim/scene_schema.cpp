@@ -71,7 +71,6 @@ const Field& solver_schema() {
               .def(0.01)
               .above(0)
               .client_settable(),
-          integer("sort_every", "Re-sort the neighbour grid every k steps").def(1).at_least(1).at_most(1000),
       },
       "Time stepping and SPH discretisation.");
   return solver;

@@ -117,7 +117,7 @@ TEST(Scene, DefaultsAreFilledIn) {
   const Scene s = scene_from_json(base_scene());
   EXPECT_EQ(s.solver.cfl, 0.4);
   EXPECT_EQ(s.solver.kernel, "cubic_spline");
-  EXPECT_EQ(s.solver.sort_every, 1);
+  EXPECT_EQ(s.wall_layers, 0);
   EXPECT_EQ(s.solver.boundary_volume, "lattice");
   EXPECT_EQ(s.gravity, Eigen::Vector3d(0, 0, -9.81));
   EXPECT_EQ(s.wall_layers, 0);
@@ -154,9 +154,9 @@ TEST(Scene, NoWallsNeedNoWallMaterial) {
 }
 
 TEST(Scene, WholeNumberAcceptedAsInteger) {
-  const Scene s = scene_from_json(base_scene(), {"solver.sort_every=4.0"});
-  EXPECT_EQ(s.solver.sort_every, 4);
-  EXPECT_TRUE(s.source["solver"]["sort_every"].is_number_integer());
+  const Scene s = scene_from_json(base_scene(), {"domain.wall_layers=4.0"});
+  EXPECT_EQ(s.wall_layers, 4);
+  EXPECT_TRUE(s.source["domain"]["wall_layers"].is_number_integer());
 }
 
 // ---- overrides -----------------------------------------------------------------------------------------
@@ -259,7 +259,7 @@ TEST(SceneError, WrongType) {
   EXPECT_EQ(override_error("gravity=[0, 0]").path(), "gravity");
   EXPECT_EQ(override_error("gravity=[0, \"a\", 0]").path(), "gravity[1]");
   EXPECT_EQ(override_error("materials=[]").path(), "materials");
-  EXPECT_EQ(override_error("solver.sort_every=2.5").path(), "solver.sort_every");
+  EXPECT_EQ(override_error("domain.wall_layers=2.5").path(), "domain.wall_layers");
 }
 
 TEST(SceneError, NegativeSpacing) {
