@@ -1,44 +1,188 @@
 #include "bench/reference_density.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "sim/kernels/sph_kernel.h"
 
 namespace thaw {
+namespace {
 
-void reference_density(const std::vector<Float4>& pos, const std::vector<std::uint8_t>& phase,
-                       const std::vector<std::uint32_t>& cell_start, const ReferenceGrid& g, float H, float rho0,
-                       std::vector<float>& out) {
-  const long n = static_cast<long>(pos.size());
-  out.resize(pos.size());
+constexpr int kLanes = 8;
+constexpr float kPi = 3.14159265358979f;
+
+int cell_of(float x, float origin, float inv_cell, int n) {
+  return std::clamp(static_cast<int>(std::floor((x - origin) * inv_cell)), 0, n - 1);
+}
+
+// Equation of state and the per-particle outputs, as at the end of density.cl.
+inline void finish(const ReferenceParticles& p, const ReferenceParams& k, std::size_t i, float rho,
+                   ReferenceDensity& out) {
+  float pr;
+  if (k.tait) {
+    const float x = rho / k.rho0;
+    if (k.gamma == 7.0f) {
+      const float x2 = x * x, x4 = x2 * x2;
+      pr = k.B * (x4 * x2 * x - 1.0f);
+    } else {
+      pr = k.B * (std::pow(x, k.gamma) - 1.0f);
+    }
+  } else {
+    pr = k.B * (rho / k.rho0 - 1.0f);
+  }
+  pr = std::max(pr, 0.0f);
+  const bool boundary = p.phase[i] == static_cast<std::uint8_t>(Phase::Solid);
+  const float dp = pr / (rho * rho);
+  const float m = p.pos[i][3];
+  out.rho[i] = rho;
+  out.state[i] = {rho, dp, boundary ? 1.0f : 0.0f, pr};
+  out.kv[i] = (boundary ? k.visc_boundary : k.visc_fluid) * m / rho;
+  out.mp[i] = m * dp;
+}
+
+void resize(ReferenceDensity& out, std::size_t n) {
+  out.rho.resize(n);
+  out.state.resize(n);
+  out.kv.resize(n);
+  out.mp.resize(n);
+}
+
+template <bool kWendland>
+void scalar_loop(const ReferenceParticles& p, const ReferenceGrid& g, const ReferenceParams& k,
+                 ReferenceDensity& out) {
+  const long n = static_cast<long>(p.size());
+  const float H = k.H, H2 = H * H;
+  const int R = g.reach;
+  const Float4* pos = p.pos.data();
+  const std::uint32_t* cs = p.cell_start.data();
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) {
-    if (phase[i] == static_cast<std::uint8_t>(Phase::Solid)) {
-      out[i] = rho0;
-      continue;
-    }
     const Float4 pi = pos[i];
-    int c[3];
-    const int dims[3] = {g.nx, g.ny, g.nz};
-    for (int a = 0; a < 3; ++a)
-      c[a] = std::clamp(static_cast<int>(std::floor((pi[a] - g.origin[a]) * g.inv_cell)), 0, dims[a] - 1);
-    const float H2 = H * H;
-    const int R = g.reach;
+    const int cx = cell_of(pi[0], g.origin[0], g.inv_cell, g.nx);
+    const int cy = cell_of(pi[1], g.origin[1], g.inv_cell, g.ny);
+    const int cz = cell_of(pi[2], g.origin[2], g.inv_cell, g.nz);
     float rho = 0.0f;
-    for (int z = std::max(c[2] - R, 0); z <= std::min(c[2] + R, g.nz - 1); ++z)
-      for (int y = std::max(c[1] - R, 0); y <= std::min(c[1] + R, g.ny - 1); ++y) {
+    for (int z = std::max(cz - R, 0); z <= std::min(cz + R, g.nz - 1); ++z)
+      for (int y = std::max(cy - R, 0); y <= std::min(cy + R, g.ny - 1); ++y) {
         const int row = (z * g.ny + y) * g.nx;
-        const std::uint32_t jb = cell_start[row + std::max(c[0] - R, 0)];
-        const std::uint32_t je = cell_start[row + std::min(c[0] + R, g.nx - 1) + 1];
+        const std::uint32_t jb = cs[row + std::max(cx - R, 0)];
+        const std::uint32_t je = cs[row + std::min(cx + R, g.nx - 1) + 1];
         for (std::uint32_t j = jb; j < je; ++j) {
           const float dx = pi[0] - pos[j][0], dy = pi[1] - pos[j][1], dz = pi[2] - pos[j][2];
           const float r2 = dx * dx + dy * dy + dz * dz;
-          if (r2 < H2) rho += pos[j][3] * sph::cubic_spline_w(std::sqrt(r2), H);
+          if (r2 < H2)
+            rho += pos[j][3] * (kWendland ? sph::wendland_c2_w(std::sqrt(r2), H) : sph::cubic_spline_w(std::sqrt(r2), H));
         }
       }
-    out[i] = rho;
+    finish(p, k, static_cast<std::size_t>(i), rho, out);
   }
+}
+
+// Eight lanes as GCC vector types (the same operations as the device's float8 code; sqrt is AVX's).
+typedef float v8f __attribute__((vector_size(32)));
+typedef int v8i __attribute__((vector_size(32)));
+
+inline v8f load8(const float* p) {
+  v8f v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline v8f sqrt8(v8f x) { return reinterpret_cast<v8f>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x))); }
+inline v8f splat8(float x) { return v8f{} + x; }
+
+// W / sigma as a function of q = r / H (the lanes' factorised kernel, as in sim/kernels/density.cl).
+template <bool kWendland>
+inline v8f w_shape(v8f q) {
+  const v8f one = splat8(1.0f);
+  if constexpr (kWendland) {
+    q = q < one ? q : one;
+    const v8f a = one - q;
+    return a * a * a * a * (one + 4.0f * q);
+  } else {
+    const v8f a = one - q;
+    const v8f inner = 6.0f * q * q * (q - one) + one;
+    const v8f outer = 2.0f * a * a * a;
+    return q <= splat8(0.5f) ? inner : outer;  // both computed and selected, as on the device
+  }
+}
+
+template <bool kWendland>
+void lanes_loop(const ReferenceParticles& p, const ReferenceGrid& g, const ReferenceParams& k,
+                ReferenceDensity& out) {
+  const long n = static_cast<long>(p.size());
+  const float H = k.H, H2 = H * H, inv_H = 1.0f / H;
+  const float sigma = kWendland ? 21.0f / (2.0f * kPi * H * H * H) : 8.0f / (kPi * H * H * H);
+  const int R = g.reach;
+  const float* X = p.x.data();
+  const float* Y = p.y.data();
+  const float* Z = p.z.data();
+  const float* M = p.m.data();
+  const std::uint32_t* cs = p.cell_start.data();
+  const v8i lane_ids = {0, 1, 2, 3, 4, 5, 6, 7};
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < n; ++i) {
+    const float px = X[i], py = Y[i], pz = Z[i];
+    const int cx = cell_of(px, g.origin[0], g.inv_cell, g.nx);
+    const int cy = cell_of(py, g.origin[1], g.inv_cell, g.ny);
+    const int cz = cell_of(pz, g.origin[2], g.inv_cell, g.nz);
+    v8f acc = {};
+    for (int z = std::max(cz - R, 0); z <= std::min(cz + R, g.nz - 1); ++z)
+      for (int y = std::max(cy - R, 0); y <= std::min(cy + R, g.ny - 1); ++y) {
+        const int row = (z * g.ny + y) * g.nx;
+        const std::uint32_t jb = cs[row + std::max(cx - R, 0)];
+        const std::uint32_t je = cs[row + std::min(cx + R, g.nx - 1) + 1];
+        for (std::uint32_t j = jb; j < je; j += kLanes) {
+          const v8f dx = px - load8(X + j), dy = py - load8(Y + j), dz = pz - load8(Z + j);
+          const v8f r2 = dx * dx + dy * dy + dz * dz;
+          const v8i in = (lane_ids < static_cast<int>(je - j)) & (r2 < H2);
+          const v8f w = load8(M + j) * w_shape<kWendland>(sqrt8(r2) * inv_H);
+          acc += in ? w : v8f{};
+        }
+      }
+    // The device's lane tree (lanes_sum8): ((0+4) + (1+5)) + ((2+6) + (3+7)).
+    const float s0 = acc[0] + acc[4], s1 = acc[1] + acc[5], s2 = acc[2] + acc[6], s3 = acc[3] + acc[7];
+    const float rho = sigma * ((s0 + s1) + (s2 + s3));
+    finish(p, k, static_cast<std::size_t>(i), rho, out);
+  }
+}
+
+}  // namespace
+
+ReferenceParticles::ReferenceParticles(const std::vector<Float4>& position, const std::vector<std::uint8_t>& ph,
+                                       const std::vector<std::uint32_t>& starts)
+    : pos(position), phase(ph), cell_start(starts) {
+  const std::size_t padded = pos.size() + 16;
+  x.assign(padded, 0.0f);
+  y.assign(padded, 0.0f);
+  z.assign(padded, 0.0f);
+  m.assign(padded, 0.0f);
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    x[i] = pos[i][0];
+    y[i] = pos[i][1];
+    z[i] = pos[i][2];
+    m[i] = pos[i][3];
+  }
+}
+
+void reference_density_scalar(const ReferenceParticles& p, const ReferenceGrid& g, const ReferenceParams& k,
+                              ReferenceDensity& out) {
+  resize(out, p.size());
+  if (k.wendland)
+    scalar_loop<true>(p, g, k, out);
+  else
+    scalar_loop<false>(p, g, k, out);
+}
+
+void reference_density_lanes(const ReferenceParticles& p, const ReferenceGrid& g, const ReferenceParams& k,
+                             ReferenceDensity& out) {
+  resize(out, p.size());
+  if (k.wendland)
+    lanes_loop<true>(p, g, k, out);
+  else
+    lanes_loop<false>(p, g, k, out);
 }
 
 }  // namespace thaw

@@ -19,9 +19,18 @@ struct ClGrid {
   cl_int nx, ny, nz;
 };
 
-// Cells of H / kGridReach: a finer grid visits fewer candidates per neighbour (measured with
-// `thaw bench throughput`: see docs/BENCHMARKS.md).
-constexpr int kGridReach = 2;
+// Cells of H / kGridReach. A finer grid visits fewer candidates per neighbour but walks more, shorter
+// rows; with the neighbour loops on SIMD lanes, cells of H (9 rows of about 24 candidates) were the
+// fastest of H, H/2 and H/3 (`thaw bench throughput`: see docs/BENCHMARKS.md).
+constexpr int kGridReach = 1;
+
+// SIMD lanes of the neighbour loops (sim/kernels/grid_common.h): candidates read at a time. 8 (AVX2
+// width) beat 4 and 16 on the AVX-512 machine of docs/BENCHMARKS.md.
+constexpr int kLanes = 8;
+
+// Work-group size of the one-work-item-per-particle kernels. Left to itself pocl picks a divisor of
+// the global size (15 for 135645 particles), which made the simple kernels a third slower.
+constexpr std::size_t kGroup = 64;
 
 const std::vector<std::string> kPrelude = {"sph_kernel.h", "grid_common.h"};
 
@@ -32,6 +41,16 @@ std::vector<std::string> with_prelude(std::initializer_list<std::string> files) 
 }
 
 cl::NDRange global_for(std::size_t n) { return cl::NDRange(std::max<std::size_t>(n, 1)); }
+
+// One work-item per particle (n of them), in groups of kGroup; the kernels ignore ids >= n.
+void launch(cl::CommandQueue& q, cl::Kernel& k, std::size_t n) {
+  const std::size_t global = (std::max<std::size_t>(n, 1) + kGroup - 1) / kGroup * kGroup;
+  q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(kGroup));
+}
+
+ClGrid cl_grid(const Solver::GridInfo& gi) {
+  return {{{gi.origin.x(), gi.origin.y(), gi.origin.z(), 0.f}}, 1.0f / gi.cell, gi.nx, gi.ny, gi.nz};
+}
 
 }  // namespace
 
@@ -86,6 +105,9 @@ SolverConstants derive_constants(const Scene& scene) {
   const double c2 = double(k.sound_speed) * k.sound_speed;
   k.stiffness = static_cast<float>(s.eos == "tait" ? k.rest_density * c2 / s.gamma : k.rest_density * c2);
   k.max_speed = static_cast<float>(s.max_speed > 0 ? s.max_speed : 5.0 * k.sound_speed);
+  const float h = k.smoothing;
+  k.visc_fluid = static_cast<float>(s.artificial_viscosity * k.sound_speed * h + 10.0 * k.kinematic_viscosity);
+  k.visc_boundary = static_cast<float>(s.boundary_viscosity * k.sound_speed * h);
   return k;
 }
 
@@ -120,8 +142,16 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   ncells_ = static_cast<std::uint32_t>(cells);
   int bits = 1;
   while (bits < 32 && (ncells_ - 1) >> bits) ++bits;
-  sort_passes_ = static_cast<std::uint32_t>((bits + 7) / 8);
+  // The fewest radix passes of at most 11 bits, the key's bits spread evenly over them (17 bits: two
+  // passes of 9 rather than three of 8).
+  sort_passes_ = static_cast<std::uint32_t>((bits + 10) / 11);
+  radix_bits_ = static_cast<std::uint32_t>((bits + int(sort_passes_) - 1) / int(sort_passes_));
+  // About 32 tiles (whole multiples of 256 particles): enough work-items to keep the cores busy, few
+  // enough that each tile's per-digit bookkeeping is small beside its particles.
+  tile_ = static_cast<std::uint32_t>(std::max<std::size_t>(256, (n_ / 32 + 255) / 256 * 256));
   ntiles_ = static_cast<std::uint32_t>((n_ + tile_ - 1) / tile_);
+  // Lane loads (SIMD lanes, sim/kernels/grid_common.h) read up to 15 floats past the last particle.
+  stride_ = static_cast<std::uint32_t>((n_ + 16 + 15) / 16 * 16);
 
   // Only the kernel and EOS this scene uses are compiled in.
   std::ostringstream opts;
@@ -129,8 +159,15 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   opts << "-DKERNEL_W=" << (wendland ? "wendland_c2_w" : "cubic_spline_w")
        << " -DKERNEL_GRAD=" << (wendland ? "wendland_c2_grad_factor" : "cubic_spline_grad_factor");
   if (scene.solver.eos == "tait") opts << " -DTHAW_EOS_TAIT";
-  opts << " -DTHAW_REACH=" << kGridReach;
-  const auto grid = cl.build(with_prelude({"grid.cl"}), opts.str());
+  if (scene.solver.eos == "tait" && scene.solver.gamma == 7.0) opts << " -DTHAW_GAMMA_7";
+  if (wendland) opts << " -DTHAW_WENDLAND";
+  // Flush subnormal floats: viscosity spreads velocities of 1e-30 m/s and less through a resting
+  // lattice, and arithmetic on subnormals made the forces pass 2-4x slower for tens of steps after a
+  // start (measured: docs/BENCHMARKS.md). Nothing physical lives below 1e-38.
+  opts << " -cl-denorms-are-zero";
+  opts << " -DTHAW_REACH=" << kGridReach << " -DTHAW_VW=" << kLanes;
+  const auto grid =
+      cl.build(with_prelude({"grid.cl"}), opts.str() + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_));
   const auto boundary = cl.build(with_prelude({"boundary.cl"}), opts.str());
   const auto density = cl.build(with_prelude({"density.cl"}), opts.str());
   const auto forces = cl.build(with_prelude({"forces.cl"}), opts.str());
@@ -140,10 +177,7 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   k_scan_ = cl::Kernel(grid, "radix_scan_rows");
   k_scatter_ = cl::Kernel(grid, "radix_scatter");
   k_starts_ = cl::Kernel(grid, "cell_starts");
-  k_g4_ = cl::Kernel(grid, "gather_float4");
-  k_gf_ = cl::Kernel(grid, "gather_float");
-  k_gu_ = cl::Kernel(grid, "gather_uint");
-  k_gc_ = cl::Kernel(grid, "gather_uchar");
+  k_reorder_ = cl::Kernel(grid, "reorder");
   k_psi_ = cl::Kernel(boundary, "boundary_psi");
   k_set_mass_ = cl::Kernel(boundary, "set_mass");
   k_density_ = cl::Kernel(density, "density");
@@ -168,12 +202,19 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     keys_[i] = buf(n * 4);
     order_[i] = buf(n * 4);
   }
-  hist_ = buf(std::size_t(256) * std::max<std::uint32_t>(ntiles_, 1) * 4);
-  totals_ = buf(256 * 4);
-  spare4_ = buf(n * 16);
+  hist_ = buf((std::size_t(1) << radix_bits_) * std::max<std::uint32_t>(ntiles_, 1) * 4);
+  totals_ = buf((std::size_t(1) << radix_bits_) * 4);
+  spare_pos_ = buf(n * 16);
+  spare_vel_ = buf(n * 16);
   spare1f_ = buf(n * 4);
-  spare_u_ = buf(n * 4);
-  spare_c_ = buf(n);
+  spare_phase_ = buf(n);
+  spare_mat_ = buf(n);
+  spare_id_ = buf(n * 4);
+  soa_ = buf(std::size_t(stride_) * 7 * 4);
+  derived_ = buf(std::size_t(stride_) * 2 * 4);
+  // The padding past the last particle is read by masked lanes only; keep it finite anyway.
+  cl.queue().enqueueFillBuffer(soa_, 0.0f, 0, std::size_t(stride_) * 7 * 4);
+  cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(stride_) * 2 * 4);
   cell_start_ = buf((std::size_t(ncells_) + 1) * 4);
   clamped_ = buf(4);
   limits_f_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 8);
@@ -221,11 +262,7 @@ void Solver::build_grid() {
   if (n_ == 0) return;
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(n_);
-  ClGrid g{{{grid_.origin.x(), grid_.origin.y(), grid_.origin.z(), 0.f}},
-           1.0f / grid_.cell,
-           grid_.nx,
-           grid_.ny,
-           grid_.nz};
+  const ClGrid g = cl_grid(grid_);
   const auto& d = scene_.domain;
   const cl_float4 dmin{{float(d.min.x()), float(d.min.y()), float(d.min.z()), 0.f}};
   const cl_float4 dmax{{float(d.max.x()), float(d.max.y()), float(d.max.z()), 0.f}};
@@ -239,11 +276,11 @@ void Solver::build_grid() {
   k_cell_keys_.setArg(7, dmin);
   k_cell_keys_.setArg(8, dmax);
   k_cell_keys_.setArg(9, n);
-  q.enqueueNDRangeKernel(k_cell_keys_, cl::NullRange, global_for(n_));
+  launch(q, k_cell_keys_, n_);
 
   for (std::uint32_t pass = 0; pass < sort_passes_; ++pass) {
     const int src = pass % 2, dst = 1 - src;
-    const cl_uint shift = 8 * pass;
+    const cl_uint shift = radix_bits_ * pass;
     k_hist_.setArg(0, keys_[src]);
     k_hist_.setArg(1, hist_);
     k_hist_.setArg(2, shift);
@@ -254,7 +291,7 @@ void Solver::build_grid() {
     k_scan_.setArg(0, hist_);
     k_scan_.setArg(1, totals_);
     k_scan_.setArg(2, ntiles_);
-    q.enqueueNDRangeKernel(k_scan_, cl::NullRange, cl::NDRange(256));
+    q.enqueueNDRangeKernel(k_scan_, cl::NullRange, cl::NDRange(std::size_t(1) << radix_bits_));
     k_scatter_.setArg(0, keys_[src]);
     k_scatter_.setArg(1, order_[src]);
     k_scatter_.setArg(2, keys_[dst]);
@@ -270,38 +307,44 @@ void Solver::build_grid() {
   const cl::Buffer& keys = keys_[sort_passes_ % 2];
   const cl::Buffer& order = order_[sort_passes_ % 2];
 
-  // Every per-particle state buffer follows the sort (a new buffer must be added here).
-  auto gather = [&](cl::Kernel& k, cl::Buffer& data, cl::Buffer& spare) {
-    k.setArg(0, order);
-    k.setArg(1, data);
-    k.setArg(2, spare);
-    k.setArg(3, n);
-    q.enqueueNDRangeKernel(k, cl::NullRange, global_for(n_));
-    std::swap(data, spare);
-  };
-  gather(k_g4_, position_, spare4_);
-  gather(k_g4_, velocity_, spare4_);
-  gather(k_gf_, density_, spare1f_);
-  gather(k_gc_, phase_, spare_c_);
-  gather(k_gc_, material_, spare_c_);
-  gather(k_gu_, id_, spare_u_);
+  // Every per-particle state buffer follows the sort (a new buffer must be added here and to the
+  // reorder kernel), in one pass.
+  k_reorder_.setArg(0, order);
+  k_reorder_.setArg(1, n);
+  k_reorder_.setArg(2, position_);
+  k_reorder_.setArg(3, spare_pos_);
+  k_reorder_.setArg(4, velocity_);
+  k_reorder_.setArg(5, spare_vel_);
+  k_reorder_.setArg(6, density_);
+  k_reorder_.setArg(7, spare1f_);
+  k_reorder_.setArg(8, phase_);
+  k_reorder_.setArg(9, spare_phase_);
+  k_reorder_.setArg(10, material_);
+  k_reorder_.setArg(11, spare_mat_);
+  k_reorder_.setArg(12, id_);
+  k_reorder_.setArg(13, spare_id_);
+  k_reorder_.setArg(14, soa_);
+  k_reorder_.setArg(15, stride_);
+  launch(q, k_reorder_, n_);
+  std::swap(position_, spare_pos_);
+  std::swap(velocity_, spare_vel_);
+  std::swap(density_, spare1f_);
+  std::swap(phase_, spare_phase_);
+  std::swap(material_, spare_mat_);
+  std::swap(id_, spare_id_);
 
   k_starts_.setArg(0, keys);
   k_starts_.setArg(1, cell_start_);
   k_starts_.setArg(2, n);
   k_starts_.setArg(3, ncells_);
-  q.enqueueNDRangeKernel(k_starts_, cl::NullRange, cl::NDRange(n_ + 1));
+  launch(q, k_starts_, n_ + 1);
 }
 
 void Solver::compute_boundary_psi() {
   build_grid();
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(n_);
-  ClGrid g{{{grid_.origin.x(), grid_.origin.y(), grid_.origin.z(), 0.f}},
-           1.0f / grid_.cell,
-           grid_.nx,
-           grid_.ny,
-           grid_.nz};
+  const ClGrid g = cl_grid(grid_);
   k_psi_.setArg(0, position_);
   k_psi_.setArg(1, phase_);
   k_psi_.setArg(2, cell_start_);
@@ -310,64 +353,58 @@ void Solver::compute_boundary_psi() {
   k_psi_.setArg(5, k_.rest_density);
   k_psi_.setArg(6, spare1f_);
   k_psi_.setArg(7, n);
-  q.enqueueNDRangeKernel(k_psi_, cl::NullRange, global_for(n_));
+  launch(q, k_psi_, n_);
   k_set_mass_.setArg(0, position_);
   k_set_mass_.setArg(1, spare1f_);
   k_set_mass_.setArg(2, n);
-  q.enqueueNDRangeKernel(k_set_mass_, cl::NullRange, global_for(n_));
+  launch(q, k_set_mass_, n_);
   q.finish();
 }
 
 void Solver::compute_density() {
   if (n_ == 0) return;
-  ClGrid g{{{grid_.origin.x(), grid_.origin.y(), grid_.origin.z(), 0.f}},
-           1.0f / grid_.cell,
-           grid_.nx,
-           grid_.ny,
-           grid_.nz};
+  const ClGrid g = cl_grid(grid_);
+  const auto& s = scene_.solver;
   k_density_.setArg(0, position_);
-  k_density_.setArg(1, phase_);
-  k_density_.setArg(2, cell_start_);
-  k_density_.setArg(3, sizeof(g), &g);
-  k_density_.setArg(4, k_.support);
-  k_density_.setArg(5, k_.rest_density);
-  k_density_.setArg(6, k_.stiffness);
-  k_density_.setArg(7, static_cast<float>(scene_.solver.gamma));
-  k_density_.setArg(8, density_);
-  k_density_.setArg(9, state_);
-  k_density_.setArg(10, static_cast<cl_uint>(n_));
-  cl_.queue().enqueueNDRangeKernel(k_density_, cl::NullRange, global_for(n_));
+  k_density_.setArg(1, soa_);
+  k_density_.setArg(2, stride_);
+  k_density_.setArg(3, phase_);
+  k_density_.setArg(4, cell_start_);
+  k_density_.setArg(5, sizeof(g), &g);
+  k_density_.setArg(6, k_.support);
+  k_density_.setArg(7, k_.rest_density);
+  k_density_.setArg(8, k_.stiffness);
+  k_density_.setArg(9, static_cast<float>(s.gamma));
+  k_density_.setArg(10, k_.visc_fluid);
+  k_density_.setArg(11, k_.visc_boundary);
+  k_density_.setArg(12, density_);
+  k_density_.setArg(13, state_);
+  k_density_.setArg(14, derived_);
+  k_density_.setArg(15, static_cast<cl_uint>(n_));
+  launch(cl_.queue(), k_density_, n_);
 }
 
 void Solver::compute_forces() {
   if (n_ == 0) return;
-  ClGrid g{{{grid_.origin.x(), grid_.origin.y(), grid_.origin.z(), 0.f}},
-           1.0f / grid_.cell,
-           grid_.nx,
-           grid_.ny,
-           grid_.nz};
-  const auto& s = scene_.solver;
+  const ClGrid g = cl_grid(grid_);
   const float h = k_.smoothing;
-  // 2(d+2) nu + alpha c h: Monaghan 2005 eq. 4.8 and its artificial-viscosity equivalent.
-  const float visc_fluid =
-      static_cast<float>(s.artificial_viscosity * k_.sound_speed * h + 10.0 * k_.kinematic_viscosity);
-  const float visc_boundary = static_cast<float>(s.boundary_viscosity * k_.sound_speed * h);
   const cl_float4 gravity{
       {float(scene_.gravity.x()), float(scene_.gravity.y()), float(scene_.gravity.z()), 0.f}};
   k_forces_.setArg(0, position_);
   k_forces_.setArg(1, velocity_);
-  k_forces_.setArg(2, state_);
-  k_forces_.setArg(3, phase_);
-  k_forces_.setArg(4, cell_start_);
-  k_forces_.setArg(5, sizeof(g), &g);
-  k_forces_.setArg(6, k_.support);
-  k_forces_.setArg(7, gravity);
-  k_forces_.setArg(8, visc_fluid);
-  k_forces_.setArg(9, visc_boundary);
-  k_forces_.setArg(10, 0.01f * h * h);
-  k_forces_.setArg(11, accel_);
-  k_forces_.setArg(12, static_cast<cl_uint>(n_));
-  cl_.queue().enqueueNDRangeKernel(k_forces_, cl::NullRange, global_for(n_));
+  k_forces_.setArg(2, soa_);
+  k_forces_.setArg(3, derived_);
+  k_forces_.setArg(4, stride_);
+  k_forces_.setArg(5, state_);
+  k_forces_.setArg(6, phase_);
+  k_forces_.setArg(7, cell_start_);
+  k_forces_.setArg(8, sizeof(g), &g);
+  k_forces_.setArg(9, k_.support);
+  k_forces_.setArg(10, gravity);
+  k_forces_.setArg(11, 0.01f * h * h);
+  k_forces_.setArg(12, accel_);
+  k_forces_.setArg(13, static_cast<cl_uint>(n_));
+  launch(cl_.queue(), k_forces_, n_);
 }
 
 double Solver::choose_time_step() {
@@ -451,7 +488,7 @@ void Solver::integrate(double dt) {
   k_integrate_.setArg(4, static_cast<float>(dt));
   k_integrate_.setArg(5, static_cast<float>(1.0 / (1.0 + damping_ * dt)));
   k_integrate_.setArg(6, static_cast<cl_uint>(n_));
-  cl_.queue().enqueueNDRangeKernel(k_integrate_, cl::NullRange, global_for(n_));
+  launch(cl_.queue(), k_integrate_, n_);
 }
 
 void Solver::step() {

@@ -21,6 +21,9 @@ struct SolverConstants {
   float stiffness = 0;       // Tait B = rho0 c^2 / gamma, or rho0 c^2 for the linear EOS [Pa]
   float kinematic_viscosity = 0;  // physical nu [m^2/s]
   float max_speed = 0;       // blow-up threshold [m/s]
+  // Viscosity coefficients of the forces pass: 2(d+2) nu + alpha c h between fluid particles (Monaghan
+  // 2005 eq. 4.8 and its artificial-viscosity equivalent), alpha_b c h against boundary particles.
+  float visc_fluid = 0, visc_boundary = 0;
 };
 SolverConstants derive_constants(const Scene& scene);
 
@@ -54,6 +57,8 @@ class Solver {
   const Scene& scene() const { return scene_; }
 
   // Stage entry points, exposed for benchmarks and tests; step() is their composition.
+  // build_grid() also writes the copies that compute_density() and compute_forces() read: call it
+  // first after anything that moves particles.
   void build_grid();
   void compute_density();
   void compute_forces();
@@ -89,18 +94,21 @@ class Solver {
   StageTimers timers_;
   GridInfo grid_;
   std::uint32_t ncells_ = 0;
-  std::uint32_t sort_passes_ = 0;
-  std::uint32_t tile_ = 256, ntiles_ = 0;
+  std::uint32_t sort_passes_ = 0, radix_bits_ = 8;
+  std::uint32_t tile_ = 256, ntiles_ = 0;  // particles per work-item in the sort and the time-step limits
+  std::uint32_t stride_ = 0;  // length of each structure-of-arrays block: n rounded up, plus padding
 
   // Per-particle state, reordered with the sort.
   cl::Buffer position_, velocity_, density_, phase_, material_, id_;
-  // Derived each step.
-  cl::Buffer state_, accel_;
-  // Scratch: sort keys/values (two of each), histogram, spares for the gathers, cell starts, limits.
-  cl::Buffer keys_[2], order_[2], hist_, totals_, spare4_, spare1f_, spare_u_, spare_c_, cell_start_;
+  // Derived each step: pressure state, accelerations; the reorder's structure-of-arrays copy of
+  // position, mass and velocity, and the density pass's pair coefficients (read by the forces pass).
+  cl::Buffer state_, accel_, soa_, derived_;
+  // Scratch: sort keys/values (two of each), histogram, the reorder's targets, cell starts, limits.
+  cl::Buffer keys_[2], order_[2], hist_, totals_, spare_pos_, spare_vel_, spare1f_, spare_phase_, spare_mat_,
+      spare_id_, cell_start_;
   cl::Buffer clamped_, limits_f_, limits_i_;
 
-  cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_, k_g4_, k_gf_, k_gu_, k_gc_;
+  cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_, k_reorder_;
   cl::Kernel k_psi_, k_set_mass_, k_density_, k_forces_, k_limits_, k_integrate_;
 };
 

@@ -6,11 +6,35 @@
  * -Psi_b p_i/rho_i^2 grad W is conservative too but carries only half the load, so a water column
  * sinks into the floor; mirroring (p_b = p_i) or hydrostatic extrapolation (Adami et al. 2012) is not
  * an energy gradient and pumped energy into particles at a tank's vertical edges. Both measured with
- * configs/hydrostatic-tank.json and `thaw validate hydrostatic`. */
-kernel void forces(global const float4* pos, global const float4* vel, global const float4* state,
+ * configs/hydrostatic-tank.json and `thaw validate hydrostatic`.
+ * Candidates are read THAW_VW at a time (SIMD lanes: grid_common.h) from the reorder's
+ * structure-of-arrays copy (x, y, z, m, vx, vy, vz) and the per-particle factors the density pass
+ * wrote (derived: k_j m_j / rho_j, m_j p_j / rho_j^2). */
+
+/* The kernel gradient of sph_kernel.h on lanes, its normalisation factored out of the sum:
+ * grad_factor(q H, H) = sigma / H^2 grad_shape(q) for q = r / H in [0, 1) (lanes outside the support
+ * are masked). */
+#ifdef THAW_WENDLAND
+#define THAW_SIGMA(H) (21.0f / (2.0f * THAW_PI_F * (H) * (H) * (H)))
+floatV grad_shape(floatV q) {
+  q = fmin(q, 1.0f);
+  const floatV a = 1.0f - q;
+  return -20.0f * a * a * a;
+}
+#else
+#define THAW_SIGMA(H) (8.0f / (THAW_PI_F * (H) * (H) * (H)))
+floatV grad_shape(floatV q) {
+  const floatV a = 1.0f - q;
+  const floatV inner = 18.0f * q - 12.0f;
+  /* -6 sigma a^2 / (H r) = sigma / H^2 (-6 a^2 / q), only taken for q > 0.5 */
+  const floatV outer = -6.0f * a * a / fmax(q, 0.25f);
+  return select(outer, inner, q <= 0.5f);
+}
+#endif
+kernel void forces(global const float4* pos, global const float4* vel, global const float* soa,
+                   global const float* derived, const uint stride, global const float4* state,
                    global const uchar* phase, global const uint* cell_start, const Grid g, const float H,
-                   const float4 gravity, const float visc_fluid, const float visc_boundary, const float eps2,
-                   global float4* accel, const uint n) {
+                   const float4 gravity, const float eps2, global float4* accel, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   if (phase[i] == THAW_PHASE_SOLID) {
@@ -22,19 +46,37 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
   const float dpi = state[i].y;
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
-  float3 a = (float3)(0.0f);
-  FOR_EACH_NEIGHBOUR(g, cell_start, c, {
-    const float4 pj = pos[j];
-    const float3 d = pi.xyz - pj.xyz;
-    const float r2 = dot(d, d);
-    if (r2 >= H2) continue;
-    const float4 sj = state[j];
-    const float f = KERNEL_GRAD(sqrt(r2), H);
-    const int boundary = sj.z > 0.5f;
-    const float k = boundary ? visc_boundary : visc_fluid;
-    const float vd = dot(vi.xyz - vel[j].xyz, d);
-    /* -m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W  +  k (m_j/rho_j) (v_ij . x_ij)/(r^2 + eps h^2) grad W */
-    a += (pj.w * f) * (k * vd / (sj.x * (r2 + eps2)) - (dpi + sj.y)) * d;
+  const float inv_H = 1.0f / H;
+  global const float* X = soa;
+  global const float* Y = soa + stride;
+  global const float* Z = soa + 2 * stride;
+  global const float* M = soa + 3 * stride;
+  global const float* VX = soa + 4 * stride;
+  global const float* VY = soa + 5 * stride;
+  global const float* VZ = soa + 6 * stride;
+  global const float* KV = derived;
+  global const float* MP = derived + stride;
+  floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+    for (uint j = jb; j < je; j += THAW_VW) {
+      const floatV dx = pi.x - vloadV(0, X + j);
+      const floatV dy = pi.y - vloadV(0, Y + j);
+      const floatV dz = pi.z - vloadV(0, Z + j);
+      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
+                        (vi.z - vloadV(0, VZ + j)) * dz;
+      /* -m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W  +  k (m_j/rho_j) (v_ij . x_ij)/(r^2 + eps h^2) grad W,
+       * grad W = grad_factor x_ij with grad_factor = sigma / H^2 grad_shape(q). */
+      const floatV s = grad_shape(sqrt(r2) * inv_H) *
+                       (vloadV(0, KV + j) * vd / (r2 + eps2) - (vloadV(0, M + j) * dpi + vloadV(0, MP + j)));
+      /* Masked after the products: lanes past the row may hold any particle's (even non-finite) data. */
+      ax += select((floatV)(0.0f), s * dx, in);
+      ay += select((floatV)(0.0f), s * dy, in);
+      az += select((floatV)(0.0f), s * dz, in);
+    }
   })
+  const float scale = THAW_SIGMA(H) * inv_H * inv_H;
+  const float3 a = scale * (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
   accel[i] = (float4)(a + gravity.xyz, 0.0f);
 }

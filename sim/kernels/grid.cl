@@ -26,21 +26,29 @@ kernel void cell_keys(global float4* pos, global float4* vel, global const uchar
   order[i] = i;
 }
 
-/* Radix sort, 8 bits a pass. Each work-item owns one tile of consecutive particles and walks it in
- * order, so the sort is stable and deterministic without atomics (rank-based scatter). */
+/* Radix sort, THAW_RADIX_BITS bits a pass (as many as the cell keys need, spread evenly over the
+ * fewest passes of at most 11 bits: the host chooses). Each work-item owns one tile of consecutive
+ * particles and walks it in order, so the sort is stable and deterministic without atomics
+ * (rank-based scatter). hist is digit-major: hist[d * ntiles + t]. */
+#ifndef THAW_RADIX_BITS
+#define THAW_RADIX_BITS 8
+#endif
+#define THAW_RADIX_BUCKETS (1u << THAW_RADIX_BITS)
+#define THAW_RADIX_MASK (THAW_RADIX_BUCKETS - 1u)
+
 kernel void radix_histogram(global const uint* keys, global uint* hist, const uint shift, const uint n,
                             const uint tile, const uint ntiles) {
   const uint t = get_global_id(0);
   if (t >= ntiles) return;
-  for (uint d = 0; d < 256; ++d) hist[d * ntiles + t] = 0;
+  for (uint d = 0; d < THAW_RADIX_BUCKETS; ++d) hist[d * ntiles + t] = 0;
   const uint e = min(n, (t + 1) * tile);
-  for (uint i = t * tile; i < e; ++i) hist[((keys[i] >> shift) & 255u) * ntiles + t] += 1;
+  for (uint i = t * tile; i < e; ++i) hist[((keys[i] >> shift) & THAW_RADIX_MASK) * ntiles + t] += 1;
 }
 
 /* Exclusive scan of each digit's row of tile counts; the row total goes to totals[d]. */
 kernel void radix_scan_rows(global uint* hist, global uint* totals, const uint ntiles) {
   const uint d = get_global_id(0);
-  if (d >= 256) return;
+  if (d >= THAW_RADIX_BUCKETS) return;
   uint sum = 0;
   for (uint t = 0; t < ntiles; ++t) {
     const uint c = hist[d * ntiles + t];
@@ -55,16 +63,16 @@ kernel void radix_scatter(global const uint* keys_in, global const uint* vals_in
                           const uint shift, const uint n, const uint tile, const uint ntiles) {
   const uint t = get_global_id(0);
   if (t >= ntiles) return;
-  uint base[256];
+  uint base[THAW_RADIX_BUCKETS];
   uint sum = 0;
-  for (uint d = 0; d < 256; ++d) {
+  for (uint d = 0; d < THAW_RADIX_BUCKETS; ++d) {
     base[d] = sum + hist[d * ntiles + t];
     sum += totals[d];
   }
   const uint e = min(n, (t + 1) * tile);
   for (uint i = t * tile; i < e; ++i) {
     const uint k = keys_in[i];
-    const uint d = (k >> shift) & 255u;
+    const uint d = (k >> shift) & THAW_RADIX_MASK;
     const uint dst = base[d]++;
     keys_out[dst] = k;
     vals_out[dst] = vals_in[i];
@@ -80,20 +88,30 @@ kernel void cell_starts(global const uint* keys, global uint* cell_start, const 
   for (uint k = lo; k <= hi; ++k) cell_start[k] = i;
 }
 
-/* Gathers of one per-particle buffer into sorted order, one per element type. */
-kernel void gather_float4(global const uint* order, global const float4* in, global float4* out, const uint n) {
+/* The reorder: every per-particle state buffer gathered into sorted order in one pass, plus the
+ * structure-of-arrays copy the neighbour loops read (x, y, z, m, vx, vy, vz blocks of `stride`
+ * floats; see the SIMD lanes in grid_common.h). */
+kernel void reorder(global const uint* order, const uint n, global const float4* pos_in,
+                    global float4* pos_out, global const float4* vel_in, global float4* vel_out,
+                    global const float* rho_in, global float* rho_out, global const uchar* phase_in,
+                    global uchar* phase_out, global const uchar* material_in, global uchar* material_out,
+                    global const uint* id_in, global uint* id_out, global float* soa, const uint stride) {
   const uint i = get_global_id(0);
-  if (i < n) out[i] = in[order[i]];
-}
-kernel void gather_float(global const uint* order, global const float* in, global float* out, const uint n) {
-  const uint i = get_global_id(0);
-  if (i < n) out[i] = in[order[i]];
-}
-kernel void gather_uint(global const uint* order, global const uint* in, global uint* out, const uint n) {
-  const uint i = get_global_id(0);
-  if (i < n) out[i] = in[order[i]];
-}
-kernel void gather_uchar(global const uint* order, global const uchar* in, global uchar* out, const uint n) {
-  const uint i = get_global_id(0);
-  if (i < n) out[i] = in[order[i]];
+  if (i >= n) return;
+  const uint s = order[i];
+  const float4 p = pos_in[s];
+  const float4 v = vel_in[s];
+  pos_out[i] = p;
+  vel_out[i] = v;
+  rho_out[i] = rho_in[s];
+  phase_out[i] = phase_in[s];
+  material_out[i] = material_in[s];
+  id_out[i] = id_in[s];
+  soa[i] = p.x;
+  soa[stride + i] = p.y;
+  soa[2 * stride + i] = p.z;
+  soa[3 * stride + i] = p.w;
+  soa[4 * stride + i] = v.x;
+  soa[5 * stride + i] = v.y;
+  soa[6 * stride + i] = v.z;
 }

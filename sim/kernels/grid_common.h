@@ -13,6 +13,7 @@
 #define THAW_PHASE_SOLID 2
 #define THAW_PHASE_AIR 3
 
+/* Must match ClGrid in sim/solver.cpp. */
 typedef struct {
   float4 origin;   /* grid minimum corner; w unused */
   float inv_cell;  /* 1 / cell size */
@@ -25,6 +26,54 @@ int4 grid_cell(const Grid g, float4 p) {
 }
 
 uint grid_key(const Grid g, int4 c) { return (uint)((c.z * g.ny + c.y) * g.nx + c.x); }
+
+/* Visits the (2 THAW_REACH + 1)^2 rows of cells around cell c; BODY sees each row's contiguous range
+ * [jb, je) of sorted particles. Kept deliberately simple: the walk's per-row cost is a large part of
+ * a pass (measured: trimming rows to the cells that can hold a neighbour visits a quarter fewer
+ * candidates but made the density pass slower; see docs/BENCHMARKS.md). */
+#define FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, BODY)                      \
+  for (int dz_ = -THAW_REACH; dz_ <= THAW_REACH; ++dz_) {                            \
+    const int z_ = (c).z + dz_;                                                      \
+    if (z_ < 0 || z_ >= (g).nz) continue;                                            \
+    for (int dy_ = -THAW_REACH; dy_ <= THAW_REACH; ++dy_) {                          \
+      const int y_ = (c).y + dy_;                                                    \
+      if (y_ < 0 || y_ >= (g).ny) continue;                                          \
+      const int row_ = (z_ * (g).ny + y_) * (g).nx;                                  \
+      const uint jb = (cell_start)[row_ + max((c).x - THAW_REACH, 0)];               \
+      const uint je = (cell_start)[row_ + min((c).x + THAW_REACH, (g).nx - 1) + 1];  \
+      BODY                                                                           \
+    }                                                                                \
+  }
+
+/* SIMD lanes over neighbour candidates: the neighbour passes (density.cl, forces.cl) read THAW_VW
+ * consecutive sorted particles at a time (float4/8/16) from structure-of-arrays copies, with per-lane
+ * masks, so pocl emits vector code for their inner loops (it vectorizes across work-items only in
+ * loops without inner loops). Accumulating lane-wise changes only the summation order: each lane sums
+ * its own candidates in order and the lanes are added in a fixed tree (lanes_sum), so results stay
+ * deterministic. Loads may run up to THAW_VW - 1 elements past a row's end (and the last particle:
+ * the arrays are padded). */
+#ifndef THAW_VW
+#define THAW_VW 8
+#endif
+#define THAW_CAT_(a, b) a##b
+#define THAW_CAT(a, b) THAW_CAT_(a, b)
+#define floatV THAW_CAT(float, THAW_VW)
+#define intV THAW_CAT(int, THAW_VW)
+#define vloadV THAW_CAT(vload, THAW_VW)
+#if THAW_VW == 4
+#define THAW_LANE_IDS ((int4)(0, 1, 2, 3))
+#elif THAW_VW == 8
+#define THAW_LANE_IDS ((int8)(0, 1, 2, 3, 4, 5, 6, 7))
+#elif THAW_VW == 16
+#define THAW_LANE_IDS ((int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
+#else
+#error "THAW_VW must be 4, 8 or 16"
+#endif
+
+float lanes_sum4(float4 a) { return (a.x + a.y) + (a.z + a.w); }
+float lanes_sum8(float8 a) { return lanes_sum4(a.lo + a.hi); }
+float lanes_sum16(float16 a) { return lanes_sum8(a.lo + a.hi); }
+#define lanes_sum THAW_CAT(lanes_sum, THAW_VW)
 
 /* Visits every particle j in the cells within THAW_REACH of cell c; BODY sees j. */
 #define FOR_EACH_NEIGHBOUR(g, cell_start, c, BODY)                                   \

@@ -57,7 +57,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double depth = int(prm["depth_particles"]) * dx;
   Json doc = {
       {"name", "validation/dam-break"},
-      {"domain", {{"min", {0, 0, 0}}, {"max", {L, depth, 1.5 * Hc}}, {"walls", {"-x", "+x", "-y", "+y", "-z"}},
+      {"domain", {{"min", {0, 0, 0}}, {"max", {L, depth, 1.25 * Hc}}, {"walls", {"-x", "+x", "-y", "+y", "-z"}},
                   {"wall_material", "wall"}}},
       {"gravity", {0, 0, -g}},
       {"spacing", dx},
