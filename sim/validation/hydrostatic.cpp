@@ -37,8 +37,10 @@ Field params() {
 }
 
 CaseResult run(ClRuntime& cl, const Json& prm, int res) {
-  const double H = prm["height"], W = prm["width"], g = prm["gravity"], rho0 = prm["density"];
+  const double H = prm["height"], g = prm["gravity"], rho0 = prm["density"];
   const double dx = H / res;
+  // A whole number of spacings, so the fluid lattice fills the tank and the column keeps height H.
+  const double W = std::max(1.0, std::floor(double(prm["width"]) / dx + 1e-9)) * dx;
   Json doc = {
       {"name", "validation/hydrostatic"},
       {"domain", {{"min", {0, 0, 0}}, {"max", {W, W, 1.25 * H}}, {"walls", {"-x", "+x", "-y", "+y", "-z"}},
