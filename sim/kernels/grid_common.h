@@ -27,11 +27,11 @@ int4 grid_cell(const Grid g, float4 p) {
 
 uint grid_key(const Grid g, int4 c) { return (uint)((c.z * g.ny + c.y) * g.nx + c.x); }
 
-/* Visits the (2 THAW_REACH + 1)^2 rows of cells around cell c; BODY sees each row's contiguous range
+/* Visits the (2 THAW_REACH + 1)^2 rows of cells around cell c; the body sees each row's contiguous range
  * [jb, je) of sorted particles. Kept deliberately simple: the walk's per-row cost is a large part of
  * a pass (measured: trimming rows to the cells that can hold a neighbour visits a quarter fewer
  * candidates but made the density pass slower; see docs/BENCHMARKS.md). */
-#define FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, BODY)                      \
+#define FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, ...)                       \
   for (int dz_ = -THAW_REACH; dz_ <= THAW_REACH; ++dz_) {                            \
     const int z_ = (c).z + dz_;                                                      \
     if (z_ < 0 || z_ >= (g).nz) continue;                                            \
@@ -41,7 +41,7 @@ uint grid_key(const Grid g, int4 c) { return (uint)((c.z * g.ny + c.y) * g.nx + 
       const int row_ = (z_ * (g).ny + y_) * (g).nx;                                  \
       const uint jb = (cell_start)[row_ + max((c).x - THAW_REACH, 0)];               \
       const uint je = (cell_start)[row_ + min((c).x + THAW_REACH, (g).nx - 1) + 1];  \
-      BODY                                                                           \
+      __VA_ARGS__                                                                    \
     }                                                                                \
   }
 
@@ -75,19 +75,9 @@ float lanes_sum8(float8 a) { return lanes_sum4(a.lo + a.hi); }
 float lanes_sum16(float16 a) { return lanes_sum8(a.lo + a.hi); }
 #define lanes_sum THAW_CAT(lanes_sum, THAW_VW)
 
-/* Visits every particle j in the cells within THAW_REACH of cell c; BODY sees j. */
-#define FOR_EACH_NEIGHBOUR(g, cell_start, c, BODY)                                   \
-  for (int dz_ = -THAW_REACH; dz_ <= THAW_REACH; ++dz_) {                            \
-    const int z_ = (c).z + dz_;                                                      \
-    if (z_ < 0 || z_ >= (g).nz) continue;                                            \
-    for (int dy_ = -THAW_REACH; dy_ <= THAW_REACH; ++dy_) {                          \
-      const int y_ = (c).y + dy_;                                                    \
-      if (y_ < 0 || y_ >= (g).ny) continue;                                          \
-      const int row_ = (z_ * (g).ny + y_) * (g).nx;                                  \
-      const uint jb_ = (cell_start)[row_ + max((c).x - THAW_REACH, 0)];              \
-      const uint je_ = (cell_start)[row_ + min((c).x + THAW_REACH, (g).nx - 1) + 1]; \
-      for (uint j = jb_; j < je_; ++j) { BODY }                                      \
-    }                                                                                \
-  }
+/* Visits every particle j in the cells within THAW_REACH of cell c; the body (the trailing argument,
+ * commas allowed) sees j. */
+#define FOR_EACH_NEIGHBOUR(g, cell_start, c, ...) \
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb_, je_, for (uint j = jb_; j < je_; ++j) { __VA_ARGS__ })
 
 #endif
