@@ -40,6 +40,13 @@ std::vector<std::string> with_prelude(std::initializer_list<std::string> files) 
   return all;
 }
 
+// Sets a kernel's arguments in order: buffers, scalars and argument structs alike.
+template <class... Args>
+void set_args(cl::Kernel& k, const Args&... args) {
+  cl_uint i = 0;
+  (k.setArg(i++, args), ...);
+}
+
 cl::NDRange global_for(std::size_t n) { return cl::NDRange(std::max<std::size_t>(n, 1)); }
 
 // One work-item per particle (n of them), in groups of kGroup; the kernels ignore ids >= n.
@@ -106,7 +113,8 @@ SolverConstants derive_constants(const Scene& scene) {
   k.stiffness = static_cast<float>(s.eos == "tait" ? k.rest_density * c2 / s.gamma : k.rest_density * c2);
   k.max_speed = static_cast<float>(s.max_speed > 0 ? s.max_speed : 5.0 * k.sound_speed);
   const float h = k.smoothing;
-  k.visc_fluid = static_cast<float>(s.artificial_viscosity * k.sound_speed * h + 10.0 * k.kinematic_viscosity);
+  k.visc_fluid =
+      static_cast<float>(s.artificial_viscosity * k.sound_speed * h + 10.0 * k.kinematic_viscosity);
   k.visc_boundary = static_cast<float>(s.boundary_viscosity * k.sound_speed * h);
   return k;
 }
@@ -266,42 +274,18 @@ void Solver::build_grid() {
   const auto& d = scene_.domain;
   const cl_float4 dmin{{float(d.min.x()), float(d.min.y()), float(d.min.z()), 0.f}};
   const cl_float4 dmax{{float(d.max.x()), float(d.max.y()), float(d.max.z()), 0.f}};
-  k_cell_keys_.setArg(0, position_);
-  k_cell_keys_.setArg(1, velocity_);
-  k_cell_keys_.setArg(2, phase_);
-  k_cell_keys_.setArg(3, keys_[0]);
-  k_cell_keys_.setArg(4, order_[0]);
-  k_cell_keys_.setArg(5, clamped_);
-  k_cell_keys_.setArg(6, sizeof(g), &g);
-  k_cell_keys_.setArg(7, dmin);
-  k_cell_keys_.setArg(8, dmax);
-  k_cell_keys_.setArg(9, n);
+  set_args(k_cell_keys_, position_, velocity_, phase_, keys_[0], order_[0], clamped_, g, dmin, dmax, n);
   launch(q, k_cell_keys_, n_);
 
   for (std::uint32_t pass = 0; pass < sort_passes_; ++pass) {
     const int src = pass % 2, dst = 1 - src;
     const cl_uint shift = radix_bits_ * pass;
-    k_hist_.setArg(0, keys_[src]);
-    k_hist_.setArg(1, hist_);
-    k_hist_.setArg(2, shift);
-    k_hist_.setArg(3, n);
-    k_hist_.setArg(4, tile_);
-    k_hist_.setArg(5, ntiles_);
+    set_args(k_hist_, keys_[src], hist_, shift, n, tile_, ntiles_);
     q.enqueueNDRangeKernel(k_hist_, cl::NullRange, global_for(ntiles_));
-    k_scan_.setArg(0, hist_);
-    k_scan_.setArg(1, totals_);
-    k_scan_.setArg(2, ntiles_);
+    set_args(k_scan_, hist_, totals_, ntiles_);
     q.enqueueNDRangeKernel(k_scan_, cl::NullRange, cl::NDRange(std::size_t(1) << radix_bits_));
-    k_scatter_.setArg(0, keys_[src]);
-    k_scatter_.setArg(1, order_[src]);
-    k_scatter_.setArg(2, keys_[dst]);
-    k_scatter_.setArg(3, order_[dst]);
-    k_scatter_.setArg(4, hist_);
-    k_scatter_.setArg(5, totals_);
-    k_scatter_.setArg(6, shift);
-    k_scatter_.setArg(7, n);
-    k_scatter_.setArg(8, tile_);
-    k_scatter_.setArg(9, ntiles_);
+    set_args(k_scatter_, keys_[src], order_[src], keys_[dst], order_[dst], hist_, totals_, shift, n, tile_,
+             ntiles_);
     q.enqueueNDRangeKernel(k_scatter_, cl::NullRange, global_for(ntiles_));
   }
   const cl::Buffer& keys = keys_[sort_passes_ % 2];
@@ -309,22 +293,8 @@ void Solver::build_grid() {
 
   // Every per-particle state buffer follows the sort (a new buffer must be added here and to the
   // reorder kernel), in one pass.
-  k_reorder_.setArg(0, order);
-  k_reorder_.setArg(1, n);
-  k_reorder_.setArg(2, position_);
-  k_reorder_.setArg(3, spare_pos_);
-  k_reorder_.setArg(4, velocity_);
-  k_reorder_.setArg(5, spare_vel_);
-  k_reorder_.setArg(6, density_);
-  k_reorder_.setArg(7, spare1f_);
-  k_reorder_.setArg(8, phase_);
-  k_reorder_.setArg(9, spare_phase_);
-  k_reorder_.setArg(10, material_);
-  k_reorder_.setArg(11, spare_mat_);
-  k_reorder_.setArg(12, id_);
-  k_reorder_.setArg(13, spare_id_);
-  k_reorder_.setArg(14, soa_);
-  k_reorder_.setArg(15, stride_);
+  set_args(k_reorder_, order, n, position_, spare_pos_, velocity_, spare_vel_, density_, spare1f_, phase_,
+           spare_phase_, material_, spare_mat_, id_, spare_id_, soa_, stride_);
   launch(q, k_reorder_, n_);
   std::swap(position_, spare_pos_);
   std::swap(velocity_, spare_vel_);
@@ -333,10 +303,7 @@ void Solver::build_grid() {
   std::swap(material_, spare_mat_);
   std::swap(id_, spare_id_);
 
-  k_starts_.setArg(0, keys);
-  k_starts_.setArg(1, cell_start_);
-  k_starts_.setArg(2, n);
-  k_starts_.setArg(3, ncells_);
+  set_args(k_starts_, keys, cell_start_, n, ncells_);
   launch(q, k_starts_, n_ + 1);
 }
 
@@ -345,18 +312,9 @@ void Solver::compute_boundary_psi() {
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(n_);
   const ClGrid g = cl_grid(grid_);
-  k_psi_.setArg(0, position_);
-  k_psi_.setArg(1, phase_);
-  k_psi_.setArg(2, cell_start_);
-  k_psi_.setArg(3, sizeof(g), &g);
-  k_psi_.setArg(4, k_.support);
-  k_psi_.setArg(5, k_.rest_density);
-  k_psi_.setArg(6, spare1f_);
-  k_psi_.setArg(7, n);
+  set_args(k_psi_, position_, phase_, cell_start_, g, k_.support, k_.rest_density, spare1f_, n);
   launch(q, k_psi_, n_);
-  k_set_mass_.setArg(0, position_);
-  k_set_mass_.setArg(1, spare1f_);
-  k_set_mass_.setArg(2, n);
+  set_args(k_set_mass_, position_, spare1f_, n);
   launch(q, k_set_mass_, n_);
   q.finish();
 }
@@ -365,22 +323,9 @@ void Solver::compute_density() {
   if (n_ == 0) return;
   const ClGrid g = cl_grid(grid_);
   const auto& s = scene_.solver;
-  k_density_.setArg(0, position_);
-  k_density_.setArg(1, soa_);
-  k_density_.setArg(2, stride_);
-  k_density_.setArg(3, phase_);
-  k_density_.setArg(4, cell_start_);
-  k_density_.setArg(5, sizeof(g), &g);
-  k_density_.setArg(6, k_.support);
-  k_density_.setArg(7, k_.rest_density);
-  k_density_.setArg(8, k_.stiffness);
-  k_density_.setArg(9, static_cast<float>(s.gamma));
-  k_density_.setArg(10, k_.visc_fluid);
-  k_density_.setArg(11, k_.visc_boundary);
-  k_density_.setArg(12, density_);
-  k_density_.setArg(13, state_);
-  k_density_.setArg(14, derived_);
-  k_density_.setArg(15, static_cast<cl_uint>(n_));
+  set_args(k_density_, position_, soa_, stride_, phase_, cell_start_, g, k_.support, k_.rest_density,
+           k_.stiffness, static_cast<float>(s.gamma), k_.visc_fluid, k_.visc_boundary, density_, state_,
+           derived_, static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_density_, n_);
 }
 
@@ -390,20 +335,8 @@ void Solver::compute_forces() {
   const float h = k_.smoothing;
   const cl_float4 gravity{
       {float(scene_.gravity.x()), float(scene_.gravity.y()), float(scene_.gravity.z()), 0.f}};
-  k_forces_.setArg(0, position_);
-  k_forces_.setArg(1, velocity_);
-  k_forces_.setArg(2, soa_);
-  k_forces_.setArg(3, derived_);
-  k_forces_.setArg(4, stride_);
-  k_forces_.setArg(5, state_);
-  k_forces_.setArg(6, phase_);
-  k_forces_.setArg(7, cell_start_);
-  k_forces_.setArg(8, sizeof(g), &g);
-  k_forces_.setArg(9, k_.support);
-  k_forces_.setArg(10, gravity);
-  k_forces_.setArg(11, 0.01f * h * h);
-  k_forces_.setArg(12, accel_);
-  k_forces_.setArg(13, static_cast<cl_uint>(n_));
+  set_args(k_forces_, position_, velocity_, soa_, derived_, stride_, state_, phase_, cell_start_, g,
+           k_.support, gravity, 0.01f * h * h, accel_, static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_forces_, n_);
 }
 
@@ -412,14 +345,8 @@ double Solver::choose_time_step() {
   double vmax2 = 0, amax2 = 0;
   std::uint32_t fastest = 0, bad = 0xffffffffu;
   if (n_ > 0) {
-    k_limits_.setArg(0, position_);
-    k_limits_.setArg(1, velocity_);
-    k_limits_.setArg(2, accel_);
-    k_limits_.setArg(3, phase_);
-    k_limits_.setArg(4, limits_f_);
-    k_limits_.setArg(5, limits_i_);
-    k_limits_.setArg(6, static_cast<cl_uint>(n_));
-    k_limits_.setArg(7, tile_);
+    set_args(k_limits_, position_, velocity_, accel_, phase_, limits_f_, limits_i_, static_cast<cl_uint>(n_),
+             tile_);
     cl_.queue().enqueueNDRangeKernel(k_limits_, cl::NullRange, global_for(ntiles_));
     std::vector<cl_float2> f(ntiles_);
     std::vector<cl_uint2> ix(ntiles_);
@@ -453,9 +380,9 @@ double Solver::choose_time_step() {
   const char* advice = "; lower solver.max_dt or solver.cfl, or raise solver.sound_speed_factor";
   if (bad != 0xffffffffu) {
     const bool accel_only = (bad & 0x80000000u) != 0;
-    throw BlowUpError(where() + particle_at(bad & 0x7fffffffu) +
-                      (accel_only ? " has a non-finite acceleration" : " has a non-finite position or velocity") +
-                      advice);
+    throw BlowUpError(
+        where() + particle_at(bad & 0x7fffffffu) +
+        (accel_only ? " has a non-finite acceleration" : " has a non-finite position or velocity") + advice);
   }
   const double vmax = std::sqrt(vmax2);
   if (vmax > k_.max_speed) {
@@ -481,13 +408,8 @@ double Solver::choose_time_step() {
 
 void Solver::integrate(double dt) {
   if (n_ == 0) return;
-  k_integrate_.setArg(0, position_);
-  k_integrate_.setArg(1, velocity_);
-  k_integrate_.setArg(2, accel_);
-  k_integrate_.setArg(3, phase_);
-  k_integrate_.setArg(4, static_cast<float>(dt));
-  k_integrate_.setArg(5, static_cast<float>(1.0 / (1.0 + damping_ * dt)));
-  k_integrate_.setArg(6, static_cast<cl_uint>(n_));
+  set_args(k_integrate_, position_, velocity_, accel_, phase_, static_cast<float>(dt),
+           static_cast<float>(1.0 / (1.0 + damping_ * dt)), static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_integrate_, n_);
 }
 
