@@ -10,22 +10,14 @@
 
 #include "bench/reference_density.h"
 #include "sim/solver.h"
+#include "sim/validation/tank_scene.h"
 
 namespace thaw {
 
 Scene throughput_scene(std::size_t fluid) {
   // Tank 1 x 0.5 x 0.7 m, water 0.6 x 0.5 x 0.6 m in one end: fluid volume 0.18 m^3.
   const double dx = std::cbrt(0.18 / double(fluid));
-  Json doc = {
-      {"name", "bench/throughput"},
-      {"domain", {{"min", {0, 0, 0}}, {"max", {1.0, 0.5, 0.7}}, {"walls", {"-x", "+x", "-y", "+y", "-z"}},
-                  {"wall_material", "wall"}}},
-      {"spacing", dx},
-      {"materials", {{"water", {{"kind", "fluid"}, {"density", 1000.0}, {"viscosity", 1e-3}}},
-                     {"wall", {{"kind", "solid"}, {"density", 2500.0}}}}},
-      {"fluids", {{{"material", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", {0.6, 0.5, 0.6}}}}}}},
-  };
-  return scene_from_json(doc);
+  return scene_from_json(tank_scene_json({"bench/throughput", {1.0, 0.5, 0.7}, {0.6, 0.5, 0.6}, dx}));
 }
 
 namespace {
@@ -123,8 +115,8 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
     const auto device_state = solver.pressure_state();
     const auto& gi = solver.grid();
     const auto& k = solver.constants();
-    const ReferenceGrid g{{gi.origin.x(), gi.origin.y(), gi.origin.z()}, 1.0f / gi.cell, gi.nx, gi.ny, gi.nz,
-                          gi.reach};
+    const ReferenceGrid g{
+        {gi.origin.x(), gi.origin.y(), gi.origin.z()}, 1.0f / gi.cell, gi.nx, gi.ny, gi.nz, gi.reach};
     ReferenceParams prm;
     prm.H = k.support;
     prm.rho0 = k.rest_density;
@@ -192,23 +184,27 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
     row["neighbours_per_particle"] = w.neighbours;
     rows.push_back(row);
     if (print) {
-      std::printf("%-9zu %-9zu %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f | %8.4f %8.4f %8.4f %6.2f\n", std::size_t(fluid),
-                  p.size(), double(st["grid"]), double(st["density"]), double(st["forces"]),
-                  double(st["time_step"]), double(st["integrate"]), double(st["step"]), dev_us, lanes_us, scalar_us,
-                  dev_us / ref_us);
-      std::printf("          check vs device: rho max rel diff %.2e (lanes) %.2e (scalar); p max diff / max p "
-                  "%.2e / %.2e; per fluid particle %.1f candidates (%.1f lane slots), %.1f neighbours\n",
-                  double(row["reference_lanes_max_rel_diff_rho"]), double(row["reference_scalar_max_rel_diff_rho"]),
-                  double(row["reference_lanes_max_diff_p_of_max_p"]),
-                  double(row["reference_scalar_max_diff_p_of_max_p"]), w.candidates, w.lane_slots, w.neighbours);
+      std::printf("%-9zu %-9zu %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f | %8.4f %8.4f %8.4f %6.2f\n",
+                  std::size_t(fluid), p.size(), double(st["grid"]), double(st["density"]),
+                  double(st["forces"]), double(st["time_step"]), double(st["integrate"]), double(st["step"]),
+                  dev_us, lanes_us, scalar_us, dev_us / ref_us);
+      std::printf(
+          "          check vs device: rho max rel diff %.2e (lanes) %.2e (scalar); p max diff / max p "
+          "%.2e / %.2e; per fluid particle %.1f candidates (%.1f lane slots), %.1f neighbours\n",
+          double(row["reference_lanes_max_rel_diff_rho"]), double(row["reference_scalar_max_rel_diff_rho"]),
+          double(row["reference_lanes_max_diff_p_of_max_p"]),
+          double(row["reference_scalar_max_diff_p_of_max_p"]), w.candidates, w.lane_slots, w.neighbours);
     }
     std::fflush(stdout);
   }
   if (print)
     std::printf(
-        "(wall us per fluid particle-step; dens iso: the device density stage alone, run alternately with the\n"
-        " hand-written C++/OpenMP loops over the same sorted data, %d threads: ref lane (8 candidates at a time,\n"
-        " as the device) and ref scal (one at a time); ratio: dens iso / the faster reference; fastest of %d runs each)\n",
+        "(wall us per fluid particle-step; dens iso: the device density stage alone, run alternately with "
+        "the\n"
+        " hand-written C++/OpenMP loops over the same sorted data, %d threads: ref lane (8 candidates at a "
+        "time,\n"
+        " as the device) and ref scal (one at a time); ratio: dens iso / the faster reference; fastest of %d "
+        "runs each)\n",
         omp_get_max_threads(), std::max(5, o.steps));
   out["sizes"] = rows;
   return out;

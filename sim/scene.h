@@ -13,6 +13,11 @@ namespace thaw {
 struct Box {
   Eigen::Vector3d min = Eigen::Vector3d::Zero();
   Eigen::Vector3d max = Eigen::Vector3d::Zero();
+
+  // The largest u . x over the box (at the corner u points to); -max_along(-u) is the smallest.
+  double max_along(const Eigen::Vector3d& u) const {
+    return u.dot(0.5 * (min + max)) + u.cwiseAbs().dot(0.5 * (max - min));
+  }
 };
 
 struct Material {
@@ -38,23 +43,23 @@ struct Solid {
 };
 
 struct SolverSettings {
-  std::string kernel = "cubic_spline";  // "cubic_spline" | "wendland_c2"
-  double support_ratio = 2.0;           // kernel support radius / particle spacing
-  std::string eos = "tait";             // "tait" | "linear"
-  double gamma = 7.0;                   // Tait exponent
-  double speed_of_sound = 0.0;          // [m/s]; 0 = sound_speed_factor * reference_speed
-  double sound_speed_factor = 10.0;     // c = factor * v_ref keeps density error near 1/factor^2
-  double reference_speed = 0.0;         // [m/s]; 0 = sqrt(2 g H) from the tallest fluid block
-  double artificial_viscosity = 0.02;   // Monaghan alpha
-  double boundary_viscosity = 0.0;      // alpha against static solids (0 = free slip)
+  std::string kernel = "cubic_spline";      // "cubic_spline" | "wendland_c2"
+  double support_ratio = 2.0;               // kernel support radius / particle spacing
+  std::string eos = "tait";                 // "tait" | "linear"
+  double gamma = 7.0;                       // Tait exponent
+  double speed_of_sound = 0.0;              // [m/s]; 0 = sound_speed_factor * reference_speed
+  double sound_speed_factor = 10.0;         // c = factor * v_ref keeps density error near 1/factor^2
+  double reference_speed = 0.0;             // [m/s]; 0 = sqrt(2 g H) from the tallest fluid block
+  double artificial_viscosity = 0.02;       // Monaghan alpha
+  double boundary_viscosity = 0.0;          // alpha against static solids (0 = free slip)
   std::string boundary_volume = "lattice";  // "lattice": dx^3; "akinci": Akinci 2012 eq. 4, 1 / sum_k W_bk
-  double cfl = 0.4;                     // dt <= cfl * h / (c + v_max)
-  double viscous_number = 0.125;        // dt <= viscous_number * h^2 / nu
-  double force_number = 0.25;           // dt <= force_number * sqrt(h / a_max)
-  double max_dt = 1e-3;                 // [s] user cap
-  double min_dt = 1e-8;                 // [s] below this the run stops as blown up
-  double max_speed = 0.0;               // [m/s]; 0 = 5 * c; faster particles stop the run as blown up
-  double output_interval = 0.01;        // [s] metrics / export cadence in sim time
+  double cfl = 0.4;                         // dt <= cfl * h / (c + v_max)
+  double viscous_number = 0.125;            // dt <= viscous_number * h^2 / nu
+  double force_number = 0.25;               // dt <= force_number * sqrt(h / a_max)
+  double max_dt = 1e-3;                     // [s] user cap
+  double min_dt = 1e-8;                     // [s] below this the run stops as blown up
+  double max_speed = 0.0;                   // [m/s]; 0 = 5 * c; faster particles stop the run as blown up
+  double output_interval = 0.01;            // [s] metrics / export cadence in sim time
 };
 
 struct Scene {

@@ -64,15 +64,9 @@ HostParticles sample_scene(const Scene& scene) {
       const Vec3 nrm = s.normal.normalized();
       const Vec3 u = nrm.unitOrthogonal(), v = nrm.cross(u);
       Box grown{scene.domain.min - Vec3::Constant(depth), scene.domain.max + Vec3::Constant(depth)};
-      double umin = 1e300, umax = -1e300, vmin = 1e300, vmax = -1e300;
-      for (int c = 0; c < 8; ++c) {
-        const Vec3 corner((c & 1) ? grown.max.x() : grown.min.x(), (c & 2) ? grown.max.y() : grown.min.y(),
-                          (c & 4) ? grown.max.z() : grown.min.z());
-        umin = std::min(umin, (corner - s.point).dot(u));
-        umax = std::max(umax, (corner - s.point).dot(u));
-        vmin = std::min(vmin, (corner - s.point).dot(v));
-        vmax = std::max(vmax, (corner - s.point).dot(v));
-      }
+      // The plane's (u, v) coordinates, relative to s.point, that cover the grown domain.
+      const double umin = -grown.max_along(-u) - s.point.dot(u), umax = grown.max_along(u) - s.point.dot(u);
+      const double vmin = -grown.max_along(-v) - s.point.dot(v), vmax = grown.max_along(v) - s.point.dot(v);
       for (double a = std::floor(umin / dx) * dx; a <= umax; a += dx)
         for (double b = std::floor(vmin / dx) * dx; b <= vmax; b += dx)
           for (int k = 0; k < layers; ++k) {

@@ -87,22 +87,10 @@ SolverConstants derive_constants(const Scene& scene) {
   if (v_ref <= 0) {
     const double g = scene.gravity.norm();
     if (g > 0) {
-      const Eigen::Vector3d down = scene.gravity / g;
+      const Eigen::Vector3d up = -scene.gravity / g;
       double top = -std::numeric_limits<double>::infinity();
-      for (const auto& f : scene.fluids)
-        for (int c = 0; c < 8; ++c) {
-          const Eigen::Vector3d p((c & 1) ? f.box.max.x() : f.box.min.x(),
-                                  (c & 2) ? f.box.max.y() : f.box.min.y(),
-                                  (c & 4) ? f.box.max.z() : f.box.min.z());
-          top = std::max(top, -down.dot(p));
-        }
-      double bottom = std::numeric_limits<double>::infinity();
-      for (int c = 0; c < 8; ++c) {
-        const auto& d = scene.domain;
-        const Eigen::Vector3d p((c & 1) ? d.max.x() : d.min.x(), (c & 2) ? d.max.y() : d.min.y(),
-                                (c & 4) ? d.max.z() : d.min.z());
-        bottom = std::min(bottom, -down.dot(p));
-      }
+      for (const auto& f : scene.fluids) top = std::max(top, f.box.max_along(up));
+      const double bottom = -scene.domain.max_along(-up);
       if (!scene.fluids.empty()) v_ref = std::sqrt(2.0 * g * std::max(0.0, top - bottom));
     }
     for (const auto& f : scene.fluids) v_ref = std::max(v_ref, f.velocity.norm());

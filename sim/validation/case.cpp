@@ -48,7 +48,8 @@ Json case_parameters(const ValidationCase& c, const std::vector<std::string>& ov
   return doc;
 }
 
-CaseResult run_validation(ClRuntime& cl, const std::string& name, int res, const std::vector<std::string>& overrides) {
+CaseResult run_validation(ClRuntime& cl, const std::string& name, int res,
+                          const std::vector<std::string>& overrides) {
   const auto& c = find_case(name);
   if (res < 0) throw Error("--res must be positive");
   const Json params = case_parameters(c, overrides);

@@ -12,6 +12,7 @@
 #include "sim/solver.h"
 #include "sim/validation/case.h"
 #include "sim/validation/hydrostatic_profile.h"
+#include "sim/validation/tank_scene.h"
 
 namespace thaw {
 namespace {
@@ -33,19 +34,22 @@ double martin_moyce(double t_star) {
 }
 
 Field params() {
-  return object("", {
-      number("width", "Column width a").in("m").def(0.05715).above(0),
-      number("height_ratio", "Column height / a (Martin & Moyce's data are for 2)").def(2.0).above(0),
-      number("length_ratio", "Tank length / a").def(5.0).above(1),
-      integer("depth_particles", "Tank depth (y) in particle spacings; walls there are free-slip").def(4).at_least(1),
-      number("gravity", "Gravitational acceleration g").in("m/s^2").def(9.81).above(0),
-      number("density", "Rest density").in("kg/m^3").def(1000.0).above(0),
-      number("viscosity", "Dynamic viscosity").in("Pa s").def(1.0e-3).at_least(0),
-      number("t_star_min", "Start of the compared window in T* = t sqrt(2g/a)").def(1.0).at_least(0),
-      number("t_star_max", "End of the compared window in T*").def(3.0).above(0),
-      number("gate", "Gate on |Z - Z_ref| / Z_ref at each compared time").def(0.10).above(0),
-      solver_schema_with({{"artificial_viscosity", 0.02}}),
-  });
+  return object(
+      "", {
+              number("width", "Column width a").in("m").def(0.05715).above(0),
+              number("height_ratio", "Column height / a (Martin & Moyce's data are for 2)").def(2.0).above(0),
+              number("length_ratio", "Tank length / a").def(5.0).above(1),
+              integer("depth_particles", "Tank depth (y) in particle spacings; walls there are free-slip")
+                  .def(4)
+                  .at_least(1),
+              number("gravity", "Gravitational acceleration g").in("m/s^2").def(9.81).above(0),
+              number("density", "Rest density").in("kg/m^3").def(1000.0).above(0),
+              number("viscosity", "Dynamic viscosity").in("Pa s").def(1.0e-3).at_least(0),
+              number("t_star_min", "Start of the compared window in T* = t sqrt(2g/a)").def(1.0).at_least(0),
+              number("t_star_max", "End of the compared window in T*").def(3.0).above(0),
+              number("gate", "Gate on |Z - Z_ref| / Z_ref at each compared time").def(0.10).above(0),
+              solver_schema_with({{"artificial_viscosity", 0.02}}),
+          });
 }
 
 CaseResult run(ClRuntime& cl, const Json& prm, int res) {
@@ -55,17 +59,14 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double dx = a / res;
   const double L = double(prm["length_ratio"]) * a, Hc = double(prm["height_ratio"]) * a;
   const double depth = int(prm["depth_particles"]) * dx;
-  Json doc = {
-      {"name", "validation/dam-break"},
-      {"domain", {{"min", {0, 0, 0}}, {"max", {L, depth, 1.25 * Hc}}, {"walls", {"-x", "+x", "-y", "+y", "-z"}},
-                  {"wall_material", "wall"}}},
-      {"gravity", {0, 0, -g}},
-      {"spacing", dx},
-      {"solver", prm["solver"]},
-      {"materials", {{"water", {{"kind", "fluid"}, {"density", rho0}, {"viscosity", prm["viscosity"]}}},
-                     {"wall", {{"kind", "solid"}, {"density", 2500.0}}}}},
-      {"fluids", {{{"material", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", {a, depth, Hc}}}}}}},
-  };
+  const Json doc = tank_scene_json({"validation/dam-break",
+                                    {L, depth, 1.25 * Hc},
+                                    {a, depth, Hc},
+                                    dx,
+                                    g,
+                                    rho0,
+                                    prm["viscosity"],
+                                    prm["solver"]});
   const Scene scene = scene_from_json(doc);
 
   // Compared times: Martin & Moyce's own points inside the window, and the window's ends.
@@ -119,8 +120,10 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
 }  // namespace
 
 ValidationCase dam_break_case() {
-  return {"dam-break", "collapse of a 1 x 2 water column: surge front vs Martin & Moyce (1952), gate 10 % for T* in [1, 3]",
-          20, params, run};
+  return {
+      "dam-break",
+      "collapse of a 1 x 2 water column: surge front vs Martin & Moyce (1952), gate 10 % for T* in [1, 3]",
+      20, params, run};
 }
 
 }  // namespace thaw

@@ -13,27 +13,39 @@
 #include "sim/solver.h"
 #include "sim/validation/case.h"
 #include "sim/validation/hydrostatic_profile.h"
+#include "sim/validation/tank_scene.h"
 
 namespace thaw {
 namespace {
 
 Field params() {
-  return object("", {
-      number("height", "Water column height H").in("m").def(0.2).above(0),
-      number("width", "Tank width in x and y").in("m").def(0.15).above(0),
-      number("gravity", "Gravitational acceleration g").in("m/s^2").def(9.81).above(0),
-      number("density", "Rest density rho0").in("kg/m^3").def(1000.0).above(0),
-      number("viscosity", "Dynamic viscosity").in("Pa s").def(1.0e-3).at_least(0),
-      number("settle_time", "Damped settling before the free run").in("s").def(1.5).at_least(0),
-      number("damping", "Velocity relaxation rate while settling").in("1/s").def(5.0).at_least(0),
-      number("interior_margin", "Interior: this many kernel support radii from walls and the surface").def(2.0).at_least(0),
-      number("free_time", "Undamped run after settling, over which pressure and speed are averaged").in("s").def(0.1).at_least(0),
-      integer("sample_every", "Sample the profile every k steps of the undamped run").def(5).at_least(1),
-      number("pressure_gate", "Gate on max |p - p_exact| of the interior profile, fraction of rho0 g H").def(0.01).above(0),
-      number("layer_noise_gate", "Bound on one layer's deviation from the profile, fraction of rho0 g H").def(0.05).above(0),
-      number("speed_gate", "Gate on the mean speed, fraction of sqrt(g H)").def(1e-3).above(0),
-      solver_schema_with({{"artificial_viscosity", 0.05}}),
-  });
+  return object(
+      "",
+      {
+          number("height", "Water column height H").in("m").def(0.2).above(0),
+          number("width", "Tank width in x and y").in("m").def(0.15).above(0),
+          number("gravity", "Gravitational acceleration g").in("m/s^2").def(9.81).above(0),
+          number("density", "Rest density rho0").in("kg/m^3").def(1000.0).above(0),
+          number("viscosity", "Dynamic viscosity").in("Pa s").def(1.0e-3).at_least(0),
+          number("settle_time", "Damped settling before the free run").in("s").def(1.5).at_least(0),
+          number("damping", "Velocity relaxation rate while settling").in("1/s").def(5.0).at_least(0),
+          number("interior_margin", "Interior: this many kernel support radii from walls and the surface")
+              .def(2.0)
+              .at_least(0),
+          number("free_time", "Undamped run after settling, over which pressure and speed are averaged")
+              .in("s")
+              .def(0.1)
+              .at_least(0),
+          integer("sample_every", "Sample the profile every k steps of the undamped run").def(5).at_least(1),
+          number("pressure_gate", "Gate on max |p - p_exact| of the interior profile, fraction of rho0 g H")
+              .def(0.01)
+              .above(0),
+          number("layer_noise_gate", "Bound on one layer's deviation from the profile, fraction of rho0 g H")
+              .def(0.05)
+              .above(0),
+          number("speed_gate", "Gate on the mean speed, fraction of sqrt(g H)").def(1e-3).above(0),
+          solver_schema_with({{"artificial_viscosity", 0.05}}),
+      });
 }
 
 CaseResult run(ClRuntime& cl, const Json& prm, int res) {
@@ -41,17 +53,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double dx = H / res;
   // A whole number of spacings, so the fluid lattice fills the tank and the column keeps height H.
   const double W = std::max(1.0, std::floor(double(prm["width"]) / dx + 1e-9)) * dx;
-  Json doc = {
-      {"name", "validation/hydrostatic"},
-      {"domain", {{"min", {0, 0, 0}}, {"max", {W, W, 1.25 * H}}, {"walls", {"-x", "+x", "-y", "+y", "-z"}},
-                  {"wall_material", "wall"}}},
-      {"gravity", {0, 0, -g}},
-      {"spacing", dx},
-      {"solver", prm["solver"]},
-      {"materials", {{"water", {{"kind", "fluid"}, {"density", rho0}, {"viscosity", prm["viscosity"]}}},
-                     {"wall", {{"kind", "solid"}, {"density", 2500.0}}}}},
-      {"fluids", {{{"material", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", {W, W, H}}}}}}},
-  };
+  const Json doc = tank_scene_json(
+      {"validation/hydrostatic", {W, W, 1.25 * H}, {W, W, H}, dx, g, rho0, prm["viscosity"], prm["solver"]});
   const Scene scene = scene_from_json(doc);
   const SolverConstants k = derive_constants(scene);
   const HydrostaticProfile prof = hydrostatic_profile(scene, H);
@@ -112,7 +115,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
     zlo = std::min(zlo, zm), zhi = std::max(zhi, zm);
   }
   if (sw == 0 || zhi - zlo < dx)
-    throw SceneError("interior_margin", "no interior left to measure: widen the tank (width) or lower interior_margin");
+    throw SceneError("interior_margin",
+                     "no interior left to measure: widen the tank (width) or lower interior_margin");
   const double slope = (sw * szp - sz * sp) / (sw * szz - sz * sz), intercept = (sp - slope * sz) / sw;
   MetricResult profile{0, 0, 0, prm["pressure_gate"]};
   for (double z : {zlo, zhi}) {  // a line against a (nearly linear) exact profile: worst at an end
@@ -145,8 +149,9 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
 }  // namespace
 
 ValidationCase hydrostatic_case() {
-  return {"hydrostatic", "water column at rest: pressure profile vs the exact hydrostatic one, gate 1 % of rho0 g H",
-          20, params, run};
+  return {"hydrostatic",
+          "water column at rest: pressure profile vs the exact hydrostatic one, gate 1 % of rho0 g H", 20,
+          params, run};
 }
 
 }  // namespace thaw

@@ -20,7 +20,9 @@ double HydrostaticProfile::top() const { return F(rho0 * g * H) / g; }
 
 double HydrostaticProfile::pressure_at(double z) const { return z >= top() ? 0.0 : Finv(g * (top() - z)); }
 
-double HydrostaticProfile::height_of(double z_nominal) const { return top() - F(rho0 * g * (H - z_nominal)) / g; }
+double HydrostaticProfile::height_of(double z_nominal) const {
+  return top() - F(rho0 * g * (H - z_nominal)) / g;
+}
 
 HydrostaticProfile hydrostatic_profile(const Scene& scene, double H) {
   const SolverConstants k = derive_constants(scene);
