@@ -80,8 +80,9 @@ int cmd_run(int argc, char** argv) {
 
   const auto counts = solver.particles();
   if (!quiet)
-    std::printf("thaw run: scene '%s', %zu particles (water %zu, solid %zu) on %s\n", scene.name.c_str(),
-                solver.size(), counts.count(Phase::Water), counts.count(Phase::Solid), cl.description().c_str());
+    std::printf("thaw run: scene '%s', %zu particles (water %zu, ice %zu, solid %zu) on %s\n", scene.name.c_str(),
+                solver.size(), counts.count(Phase::Water), counts.count(Phase::Ice), counts.count(Phase::Solid),
+                cl.description().c_str());
   std::fflush(stdout);
 
   std::signal(SIGINT, on_signal);
@@ -111,14 +112,14 @@ int cmd_run(int argc, char** argv) {
     interval_timers = solver.timers();
   };
   write_metrics();
-  if (exporter) exporter->write(solver.particles(), solver.time());
+  auto export_frame = [&] { exporter->write(solver.particles(), solver.time(), solver.temperatures()); };
+  if (exporter) export_frame();
 
   const auto t0 = Clock::now();
   while (!done() && !g_stop) {
     solver.step();
     ++interval_steps;
-    if (exporter && (solver.steps() - first_step) % std::uint64_t(every) == 0)
-      exporter->write(solver.particles(), solver.time());
+    if (exporter && (solver.steps() - first_step) % std::uint64_t(every) == 0) export_frame();
     if (solver.time() >= next_output - 1e-12) {
       write_metrics();
       next_output = (std::floor(solver.time() / interval + 1e-9) + 1.0) * interval;
@@ -150,6 +151,13 @@ int cmd_run(int argc, char** argv) {
                 "clamped %llu, kinetic %.4g J\n",
                 m.dt, m.max_speed, 100 * m.max_density_error, 100 * m.mean_density_error, m.fluid_mass,
                 (unsigned long long)m.clamped, m.kinetic);
+    if (m.heat) {
+      const EnergyBudget& b = m.budget;
+      std::printf("heat: ice %.6g kg, water %.6g kg, temperature %.4g..%.4g °C (mean %.4g); heat in %.6g J "
+                  "(ambient %.4g, lamps %.4g, dryers %.4g, walls %.4g, held %.4g), energy closure %.3g J\n",
+                  m.ice_mass, m.water_mass, m.min_temperature, m.max_temperature, m.mean_temperature, b.heat_in(),
+                  b.ambient, b.lamps, b.dryers, b.walls, b.held, m.closure());
+    }
   }
   return g_stop ? 130 : 0;
 }

@@ -1,8 +1,11 @@
 #include "sim/metrics.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sim/solver.h"
+#include "sim/thermal.h"
 
 namespace thaw {
 
@@ -10,10 +13,32 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
   Metrics m;
   double err_sum = 0;
   std::size_t fluid = 0;
+  m.heat = scene.heat.enabled && p.enthalpy.size() == p.size();
+  std::vector<MaterialThermal> table;
+  if (m.heat) table = material_thermal_table(scene, rest_density, scene.wall_layers > 0 ? scene.wall_layers : 2);
+  double t_sum = 0;
+  std::size_t t_count = 0;
+  m.min_temperature = std::numeric_limits<double>::infinity();
+  m.max_temperature = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < p.size(); ++i) {
     const auto phase = static_cast<Phase>(p.phase[i]);
     ++m.count[static_cast<int>(phase)];
-    if (phase == Phase::Solid) continue;
+    if (m.heat) {
+      const MaterialThermal& mt = table[p.material[i]];
+      const double h = double(p.enthalpy[i][0]) + double(p.enthalpy[i][1]);
+      const double mass = double(p.position[i][3]) * mt.thermal_mass_scale;
+      m.enthalpy += mass * h;
+      m.enthalpy_scale += mass * std::abs(h);
+      if (phase == Phase::Water || phase == Phase::Ice) {
+        (phase == Phase::Ice ? m.ice_mass : m.water_mass) += mass;
+        const double T = temperature_at(mt, h);
+        m.min_temperature = std::min(m.min_temperature, T);
+        m.max_temperature = std::max(m.max_temperature, T);
+        t_sum += T;
+        ++t_count;
+      }
+    }
+    if (phase == Phase::Solid || phase == Phase::Ice) continue;
     const auto& x = p.position[i];
     const auto& v = p.velocity[i];
     const double mass = x[3];
@@ -30,6 +55,9 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
     ++fluid;
   }
   m.mean_density_error = fluid ? err_sum / double(fluid) : 0.0;
+  m.mean_temperature = t_count ? t_sum / double(t_count) : 0.0;
+  if (!t_count) m.min_temperature = m.max_temperature = 0.0;
+  if (!m.heat) m.water_mass = m.fluid_mass;
   return m;
 }
 
@@ -39,6 +67,7 @@ Metrics measure(const Solver& s) {
   m.dt = s.dt();
   m.steps = s.steps();
   m.clamped = s.clamped();
+  m.budget = s.energy_budget();
   return m;
 }
 
@@ -56,8 +85,28 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
   j["max_speed"] = m.max_speed;
   j["max_density_error"] = m.max_density_error;
   j["mean_density_error"] = m.mean_density_error;
-  j["total_mass"] = m.fluid_mass;
+  j["total_mass"] = m.heat ? m.water_mass + m.ice_mass : m.fluid_mass;
   j["energy"] = {{"kinetic", m.kinetic}, {"potential", m.potential}, {"mechanical", m.kinetic + m.potential}};
+  if (m.heat) {
+    const EnergyBudget& b = m.budget;
+    j["mass"] = {{"water", m.water_mass}, {"ice", m.ice_mass}};
+    j["temperature"] = {{"min", m.min_temperature}, {"mean", m.mean_temperature}, {"max", m.max_temperature}};
+    const double gross = std::abs(b.ambient) + std::abs(b.lamps) + std::abs(b.dryers) + std::abs(b.walls) +
+                         std::abs(b.held);
+    j["heat"] = {
+        {"enthalpy", m.enthalpy},
+        {"in",
+         {{"ambient", b.ambient},
+          {"lamps", b.lamps},
+          {"dryers", b.dryers},
+          {"walls", b.walls},
+          {"held", b.held},
+          {"total", b.heat_in()}}},
+        {"lamps", {{"emitted", b.lamp_emitted}, {"absorbed", b.lamps}, {"escaped", b.lamp_escaped}}},
+        {"closure", m.closure()},
+        {"closure_relative", m.closure() / std::max({m.enthalpy_scale, gross, 1e-300})},
+    };
+  }
   return j;
 }
 

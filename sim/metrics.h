@@ -2,10 +2,9 @@
 // What a run reports per output interval (`--metrics FILE.jsonl`): conserved sums in double.
 #include "sim/particles.h"
 #include "sim/scene.h"
+#include "sim/solver.h"
 
 namespace thaw {
-
-class Solver;
 
 struct Metrics {
   double time = 0, dt = 0;
@@ -18,6 +17,14 @@ struct Metrics {
   double fluid_mass = 0;         // [kg], summed in double
   double kinetic = 0;            // [J]
   double potential = 0;          // [J], -sum m g.x
+  // Heat (scenes with heat.enabled): physical masses, temperatures over ice and water, and the budget.
+  bool heat = false;
+  double water_mass = 0, ice_mass = 0;  // [kg]
+  double min_temperature = 0, mean_temperature = 0, max_temperature = 0;  // [°C]
+  double enthalpy = 0;            // total sum m h [J]
+  double enthalpy_scale = 0;      // sum m |h| [J]: the size round-off is measured against
+  EnergyBudget budget;
+  double closure() const { return enthalpy - budget.initial - budget.heat_in(); }
 };
 
 Metrics measure(const HostParticles& p, const Scene& scene, double rest_density);

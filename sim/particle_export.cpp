@@ -70,9 +70,9 @@ struct VtkArray {
   std::string bytes;
 };
 
-// Per-particle fields shown in ParaView; temperature (and enthalpy, body id) join this list once
-// HostParticles carries them.
-std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::size_t>& order) {
+// Per-particle fields shown in ParaView; temperature when the scene has heat.
+std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::size_t>& order,
+                                 const std::vector<float>& temperature) {
   const std::size_t n = order.size();
   VtkArray velocity{"velocity", "Float32", 3, {}}, speed_array{"speed", "Float32", 1, {}};
   VtkArray phase{"phase", "UInt8", 1, {}}, material{"material", "UInt8", 1, {}};
@@ -95,6 +95,12 @@ std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::
   for (VtkArray* a : {&velocity, &speed_array, &phase, &material, &density, &mass, &id}) {
     arrays.push_back(std::move(*a));
   }
+  if (!temperature.empty()) {
+    VtkArray t{"temperature", "Float32", 1, {}};
+    t.bytes.reserve(4 * n);
+    for (std::size_t i : order) put(t.bytes, temperature[i]);
+    arrays.push_back(std::move(t));
+  }
   return arrays;
 }
 
@@ -106,9 +112,10 @@ std::string data_array_xml(const VtkArray& a, std::uint64_t offset, const char* 
 
 // UnstructuredGrid of VTK_VERTEX cells with raw appended data: each block is a UInt64 byte count
 // followed by the bytes, offsets counted from the byte after the '_' marker.
-std::string vtu_file(const HostParticles& p, const std::vector<std::size_t>& order, double time) {
+std::string vtu_file(const HostParticles& p, const std::vector<std::size_t>& order, double time,
+                     const std::vector<float>& temperature) {
   const std::size_t n = order.size();
-  const std::vector<VtkArray> point_arrays = point_data(p, order);
+  const std::vector<VtkArray> point_arrays = point_data(p, order, temperature);
 
   VtkArray points{"position", "Float32", 3, {}};
   points.bytes.reserve(12 * n);
@@ -189,9 +196,11 @@ std::array<std::uint8_t, 3> phase_colour(std::uint8_t phase) {
   return {255, 0, 255};  // a phase byte out of range stands out instead of passing as a real phase
 }
 
-// Vertex record, 32 bytes: x y z vx vy vz density (float), phase red green blue (uchar). A temperature
-// property joins the header and the record together once HostParticles carries it.
-std::string ply_file(const HostParticles& p, const std::vector<std::size_t>& order, double time) {
+// Vertex record, 32 bytes: x y z vx vy vz density (float), phase red green blue (uchar); 36 with a
+// float temperature after density.
+std::string ply_file(const HostParticles& p, const std::vector<std::size_t>& order, double time,
+                     const std::vector<float>& temperature) {
+  const bool with_t = !temperature.empty();
   std::string out =
       "ply\n"
       "format binary_little_endian 1.0\n"
@@ -207,7 +216,8 @@ std::string ply_file(const HostParticles& p, const std::vector<std::size_t>& ord
       "property float vx\n"
       "property float vy\n"
       "property float vz\n"
-      "property float density\n"
+      "property float density\n" +
+      std::string(with_t ? "property float temperature\n" : "") +
       "property uchar phase\n"
       "property uchar red\n"
       "property uchar green\n"
@@ -218,6 +228,7 @@ std::string ply_file(const HostParticles& p, const std::vector<std::size_t>& ord
     for (int c = 0; c < 3; ++c) put(out, p.position[i][c]);
     for (int c = 0; c < 3; ++c) put(out, p.velocity[i][c]);
     put(out, p.density[i]);
+    if (with_t) put(out, temperature[i]);
     put(out, p.phase[i]);
     for (std::uint8_t c : phase_colour(p.phase[i])) put(out, c);
   }
@@ -250,15 +261,18 @@ ParticleExporter::ParticleExporter(std::string dir) : dir_(std::move(dir)) {
   }
 }
 
-void ParticleExporter::write(const HostParticles& p, double time) {
+void ParticleExporter::write(const HostParticles& p, double time, const std::vector<float>& temperature) {
   check_sizes(p, dir_);
+  if (!temperature.empty() && temperature.size() != p.size())
+    throw Error("export to '" + dir_ + "': " + std::to_string(temperature.size()) + " temperatures for " +
+                std::to_string(p.size()) + " particles");
   const std::vector<std::size_t> order = id_order(p);
   const std::filesystem::path dir(dir_);
   const std::size_t frame = times_.size();
   // Exports need not survive a power cut, only never be seen half-written: rename without fsync.
-  write_file_atomically((dir / frame_name(frame, "vtu")).string(), vtu_file(p, order, time),
+  write_file_atomically((dir / frame_name(frame, "vtu")).string(), vtu_file(p, order, time, temperature),
                         Durability::Visible);
-  write_file_atomically((dir / frame_name(frame, "ply")).string(), ply_file(p, order, time),
+  write_file_atomically((dir / frame_name(frame, "ply")).string(), ply_file(p, order, time, temperature),
                         Durability::Visible);
   // The collection goes last so it never lists a frame whose files are not complete.
   std::vector<double> times = times_;

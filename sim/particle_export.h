@@ -18,7 +18,8 @@ class ParticleExporter {
   explicit ParticleExporter(std::string dir);
 
   // Writes frame_%06d.vtu and frame_%06d.ply for simulated time `time` [s], then rewrites particles.pvd.
-  void write(const HostParticles& p, double time);
+  // `temperature` [°C], one per particle in p's order, is written when not empty (scenes with heat).
+  void write(const HostParticles& p, double time, const std::vector<float>& temperature = {});
 
   std::size_t frames() const { return times_.size(); }
   const std::string& dir() const { return dir_; }

@@ -21,6 +21,7 @@ void HostParticles::resize(std::size_t n) {
   phase.resize(n);
   material.resize(n);
   id.resize(n);
+  enthalpy.resize(n);
 }
 
 std::size_t HostParticles::count(Phase p) const {

@@ -11,6 +11,7 @@ inline constexpr int kPhaseCount = 4;
 const char* phase_name(Phase p);
 
 using Float4 = std::array<float, 4>;  // layout-compatible with cl_float4
+using Float2 = std::array<float, 2>;  // layout-compatible with cl_float2
 
 struct HostParticles {
   std::vector<Float4> position;        // x, y, z [m]; w = mass [kg] (static solids: rho0 * Psi, Akinci 2012)
@@ -19,6 +20,9 @@ struct HostParticles {
   std::vector<std::uint8_t> phase;     // Phase
   std::vector<std::uint8_t> material;  // index into Scene::materials
   std::vector<std::uint32_t> id;       // stable identity: index at creation, survives sorting
+  // Specific enthalpy [J/kg] as a compensated pair (hi, lo), h = hi + lo: small heat increments on a
+  // large enthalpy (latent heat is 334 kJ/kg) would otherwise be rounded away step after step.
+  std::vector<Float2> enthalpy;
 
   std::size_t size() const { return position.size(); }
   void resize(std::size_t n);

@@ -47,6 +47,17 @@ void check_box(const Box& b, const std::string& path, const std::string& what) {
   }
 }
 
+void check_inside(const Box& domain, const Box& b, const std::string& path) {
+  for (int a = 0; a < 3; ++a) {
+    if (b.min[a] < domain.min[a] || b.max[a] > domain.max[a]) {
+      throw SceneError(path, std::string("lies outside the domain along ") + kAxis[static_cast<std::size_t>(a)] +
+                                 ": " + format_number(b.min[a]) + " m to " + format_number(b.max[a]) +
+                                 " m, the domain spans " + format_number(domain.min[a]) + " m to " +
+                                 format_number(domain.max[a]) + " m");
+    }
+  }
+}
+
 std::string names_of(const Json& materials, const std::string& kind) {
   std::string out;
   for (const auto& [name, m] : materials.items()) {
@@ -85,6 +96,7 @@ double estimated_particles(const Scene& s, double wall_layers) {
   const Eigen::Vector3d extent = s.domain.max - s.domain.min;
   double n = 0.0;
   for (const FluidBlock& f : s.fluids) n += ((f.box.max - f.box.min) / h).array().floor().prod();
+  for (const IceBlock& f : s.ice) n += ((f.box.max - f.box.min) / h).array().floor().prod();
   const double face_area[3] = {extent.y() * extent.z(), extent.x() * extent.z(), extent.x() * extent.y()};
   for (const std::string& side : s.walls) n += face_area[side[1] - 'x'] * wall_layers / (h * h);
   for (const Solid& solid : s.solids) {
@@ -127,9 +139,58 @@ Scene convert_and_check(const Json& doc) {
 
   const Json& materials = doc["materials"];
   for (const auto& [name, m] : materials.items()) {
-    s.materials.push_back(
-        {name, m["kind"].get<std::string>(), m["density"].get<double>(), m["viscosity"].get<double>()});
+    Material mat;
+    mat.name = name;
+    mat.kind = m["kind"].get<std::string>();
+    mat.density = m["density"].get<double>();
+    mat.viscosity = m["viscosity"].get<double>();
+    mat.conductivity = m["conductivity"].get<double>();
+    mat.specific_heat = m["specific_heat"].get<double>();
+    s.materials.push_back(mat);
   }
+  // Ice and the fluid it melts into share the latent heat and melting point (sim/kernels/thermal_law.h).
+  {
+    int index = 0;
+    for (const auto& [name, m] : materials.items()) {
+      if (m["kind"] == "ice") {
+        const std::string path = "materials." + name + ".melts_into";
+        const int fluid = material_index(materials, m["melts_into"], path, "fluid", "ice's melts_into");
+        Material& liquid = s.materials[static_cast<std::size_t>(fluid)];
+        if (liquid.partner >= 0)
+          throw SceneError(path, "'" + liquid.name + "' already freezes into '" +
+                                     s.materials[static_cast<std::size_t>(liquid.partner)].name +
+                                     "'; each fluid may have one ice");
+        Material& ice = s.materials[static_cast<std::size_t>(index)];
+        ice.partner = fluid;
+        liquid.partner = index;
+        ice.latent_heat = liquid.latent_heat = m["latent_heat"].get<double>();
+        ice.melting_point = liquid.melting_point = m["melting_point"].get<double>();
+      }
+      ++index;
+    }
+  }
+  s.heat.enabled = doc["heat"]["enabled"].get<bool>();
+  s.heat.time_scale = doc["heat"]["time_scale"].get<double>();
+  s.heat.exposed_area = doc["heat"]["exposed_area"].get<std::string>();
+  s.heat.ambient_temperature = doc["ambient"]["temperature"].get<double>();
+  s.heat.ambient_coefficient = doc["ambient"]["heat_transfer_coefficient"].get<double>();
+  s.heat.wall_coefficient = domain["wall_heat"]["coefficient"].get<double>();
+  s.heat.wall_temperature = domain["wall_heat"]["temperature"].get<double>();
+  const double ambient = s.heat.ambient_temperature;
+  auto temperature_of = [&](const Json& object, double fallback) {
+    return object.contains("temperature") ? object["temperature"].get<double>() : fallback;
+  };
+  // Phase-changing materials start on their own side of the melting point (no supercooled water here).
+  auto check_start = [&](int material, double T, const std::string& path) {
+    const Material& m = s.materials[static_cast<std::size_t>(material)];
+    if (m.partner < 0) return;
+    if (m.kind == "ice" && T > m.melting_point)
+      throw SceneError(path, format_number(T) + " °C is above the melting point of '" + m.name + "' (" +
+                                 format_number(m.melting_point) + " °C)");
+    if (m.kind == "fluid" && T < m.melting_point)
+      throw SceneError(path, format_number(T) + " °C is below the freezing point of '" + m.name + "' (" +
+                                 format_number(m.melting_point) + " °C); supercooled fluid is not modelled");
+  };
 
   s.walls = domain["walls"].get<std::vector<std::string>>();
   s.wall_layers = domain["wall_layers"].get<int>();
@@ -139,6 +200,15 @@ Scene convert_and_check(const Json& doc) {
   } else if (!s.walls.empty()) {
     throw SceneError("domain.wall_material", "missing: required because domain.walls is not empty");
   }
+  if (s.heat.wall_coefficient > 0) {
+    if (s.walls.empty())
+      throw SceneError("domain.wall_heat.coefficient", "needs walls: domain.walls is empty");
+    Material wall = s.materials[static_cast<std::size_t>(s.wall_material)];
+    wall.name += " (tank wall)";
+    wall.wall_heat = true;
+    s.materials.push_back(wall);
+    s.wall_material = static_cast<int>(s.materials.size()) - 1;
+  }
 
   for (std::size_t i = 0; i < doc["fluids"].size(); ++i) {
     const Json& f = doc["fluids"][i];
@@ -147,18 +217,28 @@ Scene convert_and_check(const Json& doc) {
     block.material = material_index(materials, f["material"], path + ".material", "fluid", "a fluid block");
     block.box = box(f["box"]);
     block.velocity = vec(f["velocity"]);
+    block.temperature = temperature_of(f, ambient);
     check_box(block.box, path + ".box", "empty box");
-    for (int a = 0; a < 3; ++a) {
-      if (block.box.min[a] < s.domain.min[a] || block.box.max[a] > s.domain.max[a]) {
-        throw SceneError(path + ".box", std::string("lies outside the domain along ") + kAxis[a] + ": " +
-                                            format_number(block.box.min[a]) + " m to " +
-                                            format_number(block.box.max[a]) + " m, the domain spans " +
-                                            format_number(s.domain.min[a]) + " m to " +
-                                            format_number(s.domain.max[a]) + " m");
-      }
-    }
+    check_inside(s.domain, block.box, path + ".box");
+    check_start(block.material, block.temperature, path + (f.contains("temperature") ? ".temperature" : ""));
     s.fluids.push_back(block);
   }
+
+  for (std::size_t i = 0; i < doc["ice"].size(); ++i) {
+    const Json& f = doc["ice"][i];
+    const std::string path = join_path("ice", i);
+    IceBlock block;
+    block.material = material_index(materials, f["material"], path + ".material", "ice", "an ice block");
+    block.box = box(f["box"]);
+    const double melt = s.materials[static_cast<std::size_t>(block.material)].melting_point;
+    block.temperature = temperature_of(f, std::min(ambient, melt));
+    check_box(block.box, path + ".box", "empty box");
+    check_inside(s.domain, block.box, path + ".box");
+    check_start(block.material, block.temperature, path + ".temperature");
+    s.ice.push_back(block);
+  }
+  if (s.fluids.empty() && s.ice.empty())
+    throw SceneError("fluids", "the scene has neither fluid nor ice: add a block to fluids or ice");
 
   for (std::size_t i = 0; i < doc["solids"].size(); ++i) {
     const Json& j = doc["solids"][i];
@@ -176,7 +256,67 @@ Scene convert_and_check(const Json& doc) {
       if (solid.normal.norm() == 0.0) throw SceneError(path + ".normal", "must not be zero");
       solid.normal.normalize();
     }
+    solid.temperature = temperature_of(j, ambient);
+    if (j["hold_temperature"].get<bool>()) {
+      Material held = s.materials[static_cast<std::size_t>(solid.material)];
+      held.name += " (held at " + format_number(solid.temperature) + " °C)";
+      held.held = true;
+      held.held_temperature = solid.temperature;
+      s.materials.push_back(held);
+      solid.material = static_cast<int>(s.materials.size()) - 1;
+    }
     s.solids.push_back(solid);
+  }
+  if (s.materials.size() > 255)
+    throw SceneError("solids", "too many materials (held solids count as their own): at most 255");
+
+  for (std::size_t i = 0; i < doc["lamps"].size(); ++i) {
+    const Json& j = doc["lamps"][i];
+    const std::string path = join_path("lamps", i);
+    Lamp lamp;
+    lamp.on = j["on"].get<bool>();
+    lamp.centre = vec(j["centre"]);
+    lamp.normal = vec(j["normal"]);
+    if (lamp.normal.norm() == 0.0) throw SceneError(path + ".normal", "must not be zero");
+    lamp.normal.normalize();
+    lamp.width = j["width"].get<double>();
+    lamp.height = j["height"].get<double>();
+    lamp.temperature = j["temperature"].get<double>();
+    lamp.emissivity = j["emissivity"].get<double>();
+    lamp.photons = j["photons"].get<int>();
+    s.lamps.push_back(lamp);
+  }
+  for (std::size_t i = 0; i < doc["dryers"].size(); ++i) {
+    const Json& j = doc["dryers"][i];
+    const std::string path = join_path("dryers", i);
+    Dryer d;
+    d.on = j["on"].get<bool>();
+    d.position = vec(j["position"]);
+    d.direction = vec(j["direction"]);
+    if (d.direction.norm() == 0.0) throw SceneError(path + ".direction", "must not be zero");
+    d.direction.normalize();
+    d.half_angle = j["half_angle"].get<double>();
+    d.reach = j["reach"].get<double>();
+    d.temperature = j["temperature"].get<double>();
+    d.speed = j["speed"].get<double>();
+    d.nozzle_diameter = j["nozzle_diameter"].get<double>();
+    s.dryers.push_back(d);
+  }
+
+  for (int a = 0; a < 3; ++a) {
+    if (!s.solver.periodic[static_cast<std::size_t>(a)]) continue;
+    const std::string axis(1, kAxis[static_cast<std::size_t>(a)]);
+    if (s.solver.flow)
+      throw SceneError("solver.periodic", "periodic axes need solver.flow = false: moving particles do not wrap");
+    for (const std::string& w : s.walls)
+      if (w[1] == kAxis[static_cast<std::size_t>(a)])
+        throw SceneError("domain.walls", "wall " + w + " on the periodic axis " + axis);
+    const double length = s.domain.max[a] - s.domain.min[a];
+    const double support = s.solver.support_ratio * s.spacing;
+    if (length < 3.0 * support)
+      throw SceneError("solver.periodic", "the domain is " + format_number(length) + " m long along " + axis +
+                                              ", less than 3 kernel supports (" + format_number(3.0 * support) +
+                                              " m)");
   }
 
   const double n = estimated_particles(s, wall_layer_count(doc));
@@ -231,6 +371,9 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.min_dt = j["min_dt"].get<double>();
   s.max_speed = j["max_speed"].get<double>();
   s.output_interval = j["output_interval"].get<double>();
+  s.flow = j["flow"].get<bool>();
+  for (const auto& axis : j["periodic"]) s.periodic[static_cast<std::size_t>(axis.get<std::string>()[0] - 'x')] = true;
+  s.diffusion_number = j["diffusion_number"].get<double>();
   return s;
 }
 

@@ -3,6 +3,7 @@
 // The schema — every field's name, type, unit, default, range and meaning — drives validation,
 // error messages with JSON paths, `--set` overrides and docs/SCENES.md.
 #include <Eigen/Core>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -22,24 +23,73 @@ struct Box {
 
 struct Material {
   std::string name;
-  std::string kind;         // "fluid" or "solid"
-  double density = 1000.0;  // rest density rho0 [kg/m^3]
-  double viscosity = 0.0;   // dynamic viscosity mu [Pa s] (fluids)
+  std::string kind;            // "fluid", "solid" or "ice"
+  double density = 1000.0;     // rest density rho0 [kg/m^3]
+  double viscosity = 0.0;      // dynamic viscosity mu [Pa s] (fluids)
+  double conductivity = 0.0;   // k [W/m/K]
+  double specific_heat = 0.0;  // c [J/kg/K]
+  double latent_heat = 0.0;    // L [J/kg] of an ice and the fluid it melts into; 0 otherwise
+  double melting_point = 0.0;  // T_m [°C] of the same pair
+  int partner = -1;            // ice: the fluid it melts into; fluid: the ice it freezes into; -1 none
+  // Variants the scene loader adds (named "<material> (...)"): a solid held at a temperature, and the
+  // tank walls when they exchange heat with the outside.
+  bool held = false;
+  double held_temperature = 0.0;  // [°C]
+  bool wall_heat = false;
 };
 
 struct FluidBlock {
   int material = 0;  // index into Scene::materials
   Box box;           // filled with particles on a lattice of the scene's spacing
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  double temperature = 20.0;  // initial [°C]
+};
+
+struct IceBlock {
+  int material = 0;  // an ice material
+  Box box;
+  double temperature = 0.0;  // initial [°C], at most the melting point
 };
 
 struct Solid {
   enum class Shape { Box, Plane };
   Shape shape = Shape::Box;
-  int material = 0;
+  int material = 0;  // a held solid's material is its held variant
   Box box;                                            // Shape::Box: the solid block
   Eigen::Vector3d point = Eigen::Vector3d::Zero();    // Shape::Plane: a point on the surface
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // Shape::Plane: points into the fluid
+  double temperature = 20.0;                          // initial, or held [°C]
+};
+
+struct Lamp {
+  bool on = true;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = -Eigen::Vector3d::UnitZ();  // unit, the emitting side
+  double width = 0.1, height = 0.1;                    // [m]
+  double temperature = 500.0;                          // T_s [°C]
+  double emissivity = 0.9;
+  int photons = 4096;  // per step
+};
+
+struct Dryer {
+  bool on = true;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = -Eigen::Vector3d::UnitZ();  // unit
+  double half_angle = 15.0;                               // [deg]
+  double reach = 0.3;                                     // [m]
+  double temperature = 60.0;                              // air at the nozzle [°C]
+  double speed = 10.0;                                    // air at the nozzle [m/s]
+  double nozzle_diameter = 0.04;                          // [m]
+};
+
+struct HeatSettings {
+  bool enabled = true;
+  double time_scale = 1.0;  // heat runs this much faster than the flow
+  std::string exposed_area = "iwasaki2010";
+  double ambient_temperature = 20.0;  // [°C]
+  double ambient_coefficient = 10.0;  // h [W/m^2/K]
+  double wall_coefficient = 0.0;      // U through the tank walls [W/m^2/K]
+  double wall_temperature = 20.0;     // outside the tank [°C]
 };
 
 struct SolverSettings {
@@ -60,6 +110,9 @@ struct SolverSettings {
   double min_dt = 1e-8;                     // [s] below this the run stops as blown up
   double max_speed = 0.0;                   // [m/s]; 0 = 5 * c; faster particles stop the run as blown up
   double output_interval = 0.01;            // [s] metrics / export cadence in sim time
+  bool flow = true;                         // false: particles stay put, only heat flows
+  std::array<bool, 3> periodic = {false, false, false};  // axes the domain wraps around (flow = false)
+  double diffusion_number = 0.1;            // dt <= diffusion_number * h^2 / (time_scale * alpha_max)
 };
 
 struct Scene {
@@ -74,7 +127,11 @@ struct Scene {
   SolverSettings solver;
   std::vector<Material> materials;
   std::vector<FluidBlock> fluids;
+  std::vector<IceBlock> ice;
   std::vector<Solid> solids;
+  HeatSettings heat;
+  std::vector<Lamp> lamps;
+  std::vector<Dryer> dryers;
   Json source;  // the validated document with every default filled in
 };
 

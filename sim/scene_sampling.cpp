@@ -1,9 +1,11 @@
-// Turning a scene into particles: fluid on a lattice, solids and walls as boundary particles.
+// Turning a scene into particles: fluid and ice on a lattice, solids and walls as boundary particles, each
+// with the enthalpy of its initial temperature.
 #include <Eigen/Geometry>
 #include <cmath>
 
 #include "sim/error.h"
 #include "sim/solver.h"
+#include "sim/thermal.h"
 
 namespace thaw {
 namespace {
@@ -28,8 +30,10 @@ int layer_count(const Scene& s) {
   return s.wall_layers > 0 ? s.wall_layers : static_cast<int>(std::ceil(s.solver.support_ratio - 1e-9));
 }
 
-void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase, int material) {
+void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase, int material, double enthalpy) {
   p.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
+  const float hi = static_cast<float>(enthalpy);
+  p.enthalpy.push_back({hi, static_cast<float>(enthalpy - double(hi))});
   p.velocity.push_back({float(v.x()), float(v.y()), float(v.z()), 0.f});
   p.density.push_back(0.f);
   p.phase.push_back(static_cast<std::uint8_t>(phase));
@@ -54,10 +58,11 @@ HostParticles sample_scene(const Scene& scene) {
     return false;
   };
   for (const auto& s : scene.solids) {
+    const double h_solid = enthalpy_at(scene, s.material, s.temperature);
     if (s.shape == Solid::Shape::Box) {
       lattice(s.box.min, s.box.max, dx, [&](const Vec3& x) {
         const double to_face = std::min((x - s.box.min).minCoeff(), (s.box.max - x).minCoeff());
-        if (to_face < depth) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material);
+        if (to_face < depth) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
       });
     } else {
       // Layers behind the plane, clipped to the domain grown by the layer depth.
@@ -71,12 +76,15 @@ HostParticles sample_scene(const Scene& scene) {
         for (double b = std::floor(vmin / dx) * dx; b <= vmax; b += dx)
           for (int k = 0; k < layers; ++k) {
             const Vec3 x = s.point + (a + 0.5 * dx) * u + (b + 0.5 * dx) * v - (k + 0.5) * dx * nrm;
-            if (inside(grown, x)) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material);
+            if (inside(grown, x)) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
           }
     }
   }
   // Domain walls: lattice points outside the domain, within the layer depth, on walled sides only.
   if (!scene.walls.empty()) {
+    const double h_wall = enthalpy_at(scene, scene.wall_material, scene.heat.wall_coefficient > 0
+                                                                      ? scene.heat.wall_temperature
+                                                                      : scene.heat.ambient_temperature);
     const auto& d = scene.domain;
     auto walled = [&](int axis, bool upper) {
       const std::string side = std::string(upper ? "+" : "-") + "xyz"[axis];
@@ -93,18 +101,34 @@ HostParticles sample_scene(const Scene& scene) {
         if (x[a] > d.max[a]) outside = true, ok = ok && walled(a, true);
       }
       if (outside && ok && inside(Box{lo, hi}, x))
-        add(p, x, Vec3::Zero(), 0.f, Phase::Solid, scene.wall_material);
+        add(p, x, Vec3::Zero(), 0.f, Phase::Solid, scene.wall_material, h_wall);
+    });
+  }
+  // Ice blocks: static, with the SPH mass of a boundary particle (rho0 dx^3; sim/thermal.h).
+  auto in_ice = [&](const Vec3& x, std::size_t before) {
+    for (std::size_t e = 0; e < before; ++e)
+      if (inside(scene.ice[e].box, x)) return true;
+    return false;
+  };
+  const float boundary_mass = static_cast<float>(derive_constants(scene).rest_density * dx * dx * dx);
+  for (std::size_t b = 0; b < scene.ice.size(); ++b) {
+    const auto& c = scene.ice[b];
+    const double h = enthalpy_at(scene, c.material, c.temperature);
+    lattice(c.box.min, c.box.max, dx, [&](const Vec3& x) {
+      if (!inside(scene.domain, x) || in_solid(x) || in_ice(x, b)) return;
+      add(p, x, Vec3::Zero(), boundary_mass, Phase::Ice, c.material, h);
     });
   }
   // Fluid blocks, skipping lattice points inside solids or an earlier block.
   for (std::size_t b = 0; b < scene.fluids.size(); ++b) {
     const auto& f = scene.fluids[b];
     const float mass = static_cast<float>(scene.materials[f.material].density * dx * dx * dx);
+    const double h = enthalpy_at(scene, f.material, f.temperature);
     lattice(f.box.min, f.box.max, dx, [&](const Vec3& x) {
-      if (!inside(scene.domain, x) || in_solid(x)) return;
+      if (!inside(scene.domain, x) || in_solid(x) || in_ice(x, scene.ice.size())) return;
       for (std::size_t e = 0; e < b; ++e)
         if (inside(scene.fluids[e].box, x)) return;
-      add(p, x, f.velocity, mass, Phase::Water, f.material);
+      add(p, x, f.velocity, mass, Phase::Water, f.material, h);
     });
   }
   if (p.size() > std::size_t(0xffffffffu)) throw SceneError("spacing", "too many particles for 32-bit ids");

@@ -59,7 +59,7 @@ const Field& solver_schema() {
               .in("s")
               .def(1e-3)
               .above(0)
-              .at_most(1)
+              .at_most(3600)
               .client_settable(),
           number("min_dt", "A time step below this stops the run as blown up").in("s").def(1e-8).above(0),
           number("max_speed", "A particle faster than this stops the run as blown up; 0 = 5 * c")
@@ -71,6 +71,19 @@ const Field& solver_schema() {
               .def(0.01)
               .above(0)
               .client_settable(),
+          flag("flow",
+               "Move the fluid (density, forces, integration); false = particles stay where they are and only heat "
+               "flows, at the diffusion time step (conduction studies, the Stefan problem)")
+              .def(true),
+          subset("periodic", {"x", "y", "z"},
+                 "Axes along which the domain wraps around (heat only: needs flow = false, no walls on those "
+                 "axes, and a domain at least 3 kernel supports long along them)")
+              .def(Json::array()),
+          number("diffusion_number",
+                 "Heat diffusion limit: dt <= diffusion_number * h^2 / (heat.time_scale * alpha_max)")
+              .def(0.1)
+              .above(0)
+              .at_most(0.5),
       },
       "Time stepping and SPH discretisation.");
   return solver;
@@ -108,16 +121,83 @@ const Field& scene_schema() {
                          .def(0)
                          .at_least(0)
                          .at_most(10),
+                     object("wall_heat",
+                            {
+                                number("coefficient",
+                                       "U of the heat flux U (T_outside - T_wall) through the walls' outer face; "
+                                       "0 = insulated")
+                                    .in("W/m^2/K")
+                                    .def(0.0)
+                                    .at_least(0)
+                                    .at_most(1e5)
+                                    .client_settable(),
+                                number("temperature", "Temperature outside the tank")
+                                    .in("°C")
+                                    .def(20.0)
+                                    .above(-273.15)
+                                    .at_most(1000)
+                                    .client_settable(),
+                            },
+                            "Heat exchange of the tank walls with the outside (Domaradzki & Martyn sec. 7)."),
                  },
                  "The simulated box; particles that leave it are clamped back and counted."),
           vec3("gravity", "Gravitational acceleration").in("m/s^2").def({0.0, 0.0, -9.81}).client_settable(),
           number("spacing", "Particle spacing; sets the resolution").in("m").above(0),
           solver_schema(),
+          object("heat",
+                 {
+                     flag("enabled", "Run the thermal stages: conduction, heat sources, phase change").def(true),
+                     number("time_scale",
+                            "Heat flows this many times faster than the water moves: 1 is physical; interactive "
+                            "scenes may raise it and say so in their description")
+                         .def(1.0)
+                         .above(0)
+                         .at_most(1e6)
+                         .client_settable(),
+                     choice("exposed_area", {"iwasaki2010"},
+                            "Model of each particle's surface exposed to air: iwasaki2010 = (6 - n_i) / 6 of a "
+                            "voxel's six faces, n_i the particles within 1.2 spacings (Iwasaki et al. 2010 sec. "
+                            "4)")
+                         .def("iwasaki2010"),
+                 },
+                 "Heat transfer and phase change (Iwasaki et al. 2010; DESIGN.md Numerics)."),
+          object("ambient",
+                 {
+                     number("temperature", "Air around the scene; objects without a temperature start at it")
+                         .in("°C")
+                         .def(20.0)
+                         .above(-273.15)
+                         .at_most(1000)
+                         .client_settable(),
+                     number("heat_transfer_coefficient",
+                            "h in Newton's cooling h (T_air - T) dA through the exposed surface of ice and water; "
+                            "0 = insulated")
+                         .in("W/m^2/K")
+                         .def(10.0)
+                         .at_least(0)
+                         .at_most(1e4)
+                         .client_settable(),
+                 },
+                 "Still air around the scene (the mode without air particles)."),
           map_of("materials", "<name>",
                  {
-                     choice("kind", {"fluid", "solid"}, "Fluid particles move; solids are static boundaries"),
+                     choice("kind", {"fluid", "solid", "ice"},
+                            "Fluid particles move; solids are static boundaries; ice stays in place and melts "
+                            "into its melts_into fluid"),
                      number("density", "Rest density").in("kg/m^3").above(0).at_most(1e5),
                      number("viscosity", "Dynamic viscosity (fluids)").in("Pa s").def(0.0).at_least(0),
+                     number("conductivity", "Thermal conductivity k").in("W/m/K").at_least(0).at_most(1e4),
+                     number("specific_heat", "Specific heat capacity c").in("J/kg/K").above(0).at_most(1e6),
+                     text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
+                         .when("kind", "ice"),
+                     number("latent_heat", "Latent heat of fusion L").in("J/kg").def(334000.0).above(0).at_most(1e8).when(
+                         "kind", "ice"),
+                     number("melting_point", "Melting temperature T_m")
+                         .in("°C")
+                         .def(0.0)
+                         .above(-273.15)
+                         .at_most(3000)
+                         .when("kind", "ice"),
                  },
                  "Materials by name; objects refer to them by name.")
               .non_empty(),
@@ -126,9 +206,27 @@ const Field& scene_schema() {
                        text("material", "Name of a fluid material"),
                        box_field("box", "Filled with particles on a lattice of the scene's spacing"),
                        vec3("velocity", "Initial velocity").in("m/s").def({0.0, 0.0, 0.0}),
+                       number("temperature", "Initial temperature; default ambient.temperature")
+                           .in("°C")
+                           .above(-273.15)
+                           .at_most(3000)
+                           .optional(),
                    },
                    "Blocks of fluid particles.")
-              .non_empty(),
+              .def(Json::array()),
+          array_of("ice",
+                   {
+                       text("material", "Name of an ice material"),
+                       box_field("box", "Filled with particles on a lattice of the scene's spacing"),
+                       number("temperature", "Initial temperature, at most the melting point; default "
+                                             "ambient.temperature or the melting point, whichever is lower")
+                           .in("°C")
+                           .above(-273.15)
+                           .at_most(3000)
+                           .optional(),
+                   },
+                   "Blocks of ice, held in place (rigid motion comes later); they melt into water.")
+              .def(Json::array()),
           array_of("solids",
                    {
                        choice("shape", {"box", "plane"}, "Solid block or half-space"),
@@ -137,8 +235,72 @@ const Field& scene_schema() {
                        vec3("point", "A point on the plane").in("m").when("shape", "plane"),
                        vec3("normal", "Plane normal, pointing into the fluid; need not be unit length")
                            .when("shape", "plane"),
+                       number("temperature", "Initial temperature; default ambient.temperature")
+                           .in("°C")
+                           .above(-273.15)
+                           .at_most(3000)
+                           .optional(),
+                       flag("hold_temperature",
+                            "Hold the solid at its temperature, like a heater or a cooling plate; the heat that "
+                            "takes is reported as `held` in the energy budget")
+                           .def(false),
                    },
-                   "Static solids, sampled as boundary particles.")
+                   "Static solids, sampled as boundary particles; they conduct heat.")
+              .def(Json::array()),
+          array_of("lamps",
+                   {
+                       flag("on", "Emitting").def(true).client_settable(),
+                       vec3("centre", "Centre of the emitting rectangle").in("m").client_settable(),
+                       vec3("normal", "The way the emitting face looks; need not be unit length").client_settable(),
+                       number("width", "Extent of the rectangle across the normal (horizontal where it can be)")
+                           .in("m")
+                           .above(0)
+                           .at_most(100),
+                       number("height", "Extent of the rectangle along the third axis").in("m").above(0).at_most(100),
+                       number("temperature", "Emitter temperature T_s")
+                           .in("°C")
+                           .above(-273.15)
+                           .at_most(3000)
+                           .client_settable(),
+                       number("emissivity", "Emissivity factor").def(0.9).above(0).at_most(1).client_settable(),
+                       integer("photons", "Thermal photons emitted per step").def(4096).at_least(1).at_most(1 << 22),
+                   },
+                   "Radiant heaters, as thermal photons traced through the ice and solids (Iwasaki et al. 2010 "
+                   "sec. 4 and 6): the first ice or solid voxel a photon meets absorbs it.")
+              .def(Json::array()),
+          array_of("dryers",
+                   {
+                       flag("on", "Blowing").def(true).client_settable(),
+                       vec3("position", "Nozzle position").in("m").client_settable(),
+                       vec3("direction", "Where the air blows; need not be unit length").client_settable(),
+                       number("half_angle", "Half-angle of the cone of warm air")
+                           .in("deg")
+                           .def(15.0)
+                           .above(0)
+                           .at_most(60)
+                           .client_settable(),
+                       number("reach", "Length of the cone; nothing beyond it feels the dryer")
+                           .in("m")
+                           .def(0.3)
+                           .above(0)
+                           .at_most(10)
+                           .client_settable(),
+                       number("temperature", "Air temperature at the nozzle")
+                           .in("°C")
+                           .def(60.0)
+                           .above(-100)
+                           .at_most(500)
+                           .client_settable(),
+                       number("speed", "Air speed at the nozzle").in("m/s").def(10.0).at_least(0).at_most(100).client_settable(),
+                       number("nozzle_diameter", "Sets the jet's core length (6 diameters) and the length scale of "
+                                                 "its heat-transfer coefficient")
+                           .in("m")
+                           .def(0.04)
+                           .above(0)
+                           .at_most(1),
+                   },
+                   "Hair dryers without air particles: a cone of warm, fast air that heats the exposed surface "
+                   "inside it (sim/heat_sources.h has the model).")
               .def(Json::array()),
       });
   return scene;
@@ -169,8 +331,17 @@ Checked across fields:
 - a fluid block's material is a fluid, a solid's and the walls' material is a solid, and every
   material name is defined in `materials`;
 - `domain.wall_material` is given when `domain.walls` is not empty;
-- fluid blocks lie inside the domain; plane normals are not zero;
-- `solver.min_dt` is below `solver.max_dt`.
+- fluid and ice blocks lie inside the domain; plane normals, lamp normals and dryer directions are not
+  zero; the scene has at least one fluid or ice block;
+- an ice material's `melts_into` names a fluid, and no two ice materials melt into the same fluid; ice
+  starts at or below its melting point, and a fluid that freezes starts at or above it;
+- `solver.min_dt` is below `solver.max_dt`;
+- `solver.periodic` axes need `solver.flow = false`, no walls on those axes, and a domain at least three
+  kernel supports long along them.
+
+Temperatures are in °C. Each particle carries its specific enthalpy; an ice particle turns to water when
+it has taken its whole latent heat, and water freezes when it has given it all back
+(`sim/kernels/thermal_law.h`).
 
 ## Example
 
@@ -186,12 +357,16 @@ constexpr const char* kExample = R"({
   "spacing": 0.01,
   "solver": {"kernel": "wendland_c2", "support_ratio": 3.0, "cfl": 0.3},
   "materials": {
-    "water": {"kind": "fluid", "density": 1000, "viscosity": 1.0e-3},
-    "glass": {"kind": "solid", "density": 2500},
-    "steel": {"kind": "solid", "density": 7850}
+    "water": {"kind": "fluid", "density": 1000, "viscosity": 1.0e-3, "conductivity": 0.56, "specific_heat": 4217},
+    "ice": {"kind": "ice", "density": 917, "conductivity": 2.22, "specific_heat": 2050, "melts_into": "water"},
+    "glass": {"kind": "solid", "density": 2500, "conductivity": 1.0, "specific_heat": 840},
+    "steel": {"kind": "solid", "density": 7850, "conductivity": 45, "specific_heat": 490}
   },
-  "fluids": [{"material": "water", "box": {"min": [0, 0, 0], "max": [0.2, 0.2, 0.3]}}],
-  "solids": [{"shape": "box", "material": "steel", "box": {"min": [0.4, 0.05, 0], "max": [0.45, 0.15, 0.1]}}]
+  "ambient": {"temperature": 20, "heat_transfer_coefficient": 10},
+  "fluids": [{"material": "water", "box": {"min": [0, 0, 0], "max": [0.2, 0.2, 0.3]}, "temperature": 15}],
+  "ice": [{"material": "ice", "box": {"min": [0.4, 0.05, 0.1], "max": [0.45, 0.1, 0.15]}, "temperature": -10}],
+  "solids": [{"shape": "box", "material": "steel", "box": {"min": [0.4, 0.05, 0], "max": [0.45, 0.15, 0.1]}}],
+  "dryers": [{"position": [0.55, 0.075, 0.3], "direction": [-1, 0, -1], "temperature": 60, "speed": 10}]
 }
 )";
 

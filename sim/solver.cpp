@@ -1,11 +1,15 @@
 #include "sim/solver.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
 #include "sim/error.h"
+#include "sim/kernels/dryer_model.h"
+#include "sim/photons.h"
+#include "sim/thermal.h"
 
 namespace thaw {
 namespace {
@@ -15,9 +19,10 @@ static_assert(static_cast<int>(Phase::Solid) == 2, "THAW_PHASE_SOLID in sim/kern
 // Must match `Grid` in sim/kernels/grid_common.h.
 struct ClGrid {
   cl_float4 origin;
-  cl_float inv_cell;
+  cl_float4 inv_cell;
   cl_int nx, ny, nz;
 };
+static_assert(sizeof(ClGrid) == 48, "ClGrid must match the OpenCL struct's layout");
 
 // Cells of H / kGridReach. A finer grid visits fewer candidates per neighbour but walks more, shorter
 // rows; with the neighbour loops on SIMD lanes, cells of H (9 rows of about 24 candidates) were the
@@ -32,7 +37,7 @@ constexpr int kLanes = 8;
 // the global size (15 for 135645 particles), which made the simple kernels a third slower.
 constexpr std::size_t kGroup = 64;
 
-const std::vector<std::string> kPrelude = {"sph_kernel.h", "grid_common.h"};
+const std::vector<std::string> kPrelude = {"sph_kernel.h", "grid_common.h", "sph_lanes.h"};
 
 std::vector<std::string> with_prelude(std::initializer_list<std::string> files) {
   std::vector<std::string> all = kPrelude;
@@ -56,7 +61,11 @@ void launch(cl::CommandQueue& q, cl::Kernel& k, std::size_t n) {
 }
 
 ClGrid cl_grid(const Solver::GridInfo& gi) {
-  return {{{gi.origin.x(), gi.origin.y(), gi.origin.z(), 0.f}}, 1.0f / gi.cell, gi.nx, gi.ny, gi.nz};
+  return {{{gi.origin.x(), gi.origin.y(), gi.origin.z(), 0.f}},
+          {{1.0f / gi.cells.x(), 1.0f / gi.cells.y(), 1.0f / gi.cells.z(), 0.f}},
+          gi.nx,
+          gi.ny,
+          gi.nz};
 }
 
 }  // namespace
@@ -77,6 +86,9 @@ SolverConstants derive_constants(const Scene& scene) {
                            scene.materials[fluid_material].name + "')");
     if (fluid_material < 0) fluid_material = m;
   }
+  // A scene of ice alone: its water is the fluid that appears.
+  for (const auto& c : scene.ice)
+    if (fluid_material < 0) fluid_material = scene.materials[static_cast<std::size_t>(c.material)].partner;
   const Material* fluid = fluid_material >= 0 ? &scene.materials[fluid_material] : nullptr;
   k.rest_density = static_cast<float>(fluid ? fluid->density : 1000.0);
   k.kinematic_viscosity = static_cast<float>(fluid ? fluid->viscosity / fluid->density : 0.0);
@@ -104,7 +116,43 @@ SolverConstants derive_constants(const Scene& scene) {
   k.visc_fluid =
       static_cast<float>(s.artificial_viscosity * k.sound_speed * h + 10.0 * k.kinematic_viscosity);
   k.visc_boundary = static_cast<float>(s.boundary_viscosity * k.sound_speed * h);
+
+  const double inf = std::numeric_limits<double>::infinity();
+  const double alpha = max_diffusivity(scene);
+  k.diffusion_dt = alpha > 0 ? s.diffusion_number * double(h) * h / (scene.heat.time_scale * alpha) : inf;
+  // Explicit Newton cooling of a particle of capacity rho c dx^3 through at most 6 dx^2 is stable for
+  // dt < rho c dx / (6 h); the time step keeps half of that (Solver::heat_time_step).
+  k.exposed_capacity = inf;
+  k.wall_dt = inf;
+  const double dx = scene.spacing;
+  for (const Material& m : scene.materials) {
+    if (m.kind != "solid") k.exposed_capacity = std::min(k.exposed_capacity, m.density * m.specific_heat * dx / 6.0);
+    if (m.wall_heat) {
+      const double layers = scene.wall_layers > 0 ? scene.wall_layers : std::ceil(s.support_ratio - 1e-9);
+      k.wall_dt = std::min(k.wall_dt, 0.5 * m.density * m.specific_heat * dx * layers /
+                                          (scene.heat.time_scale * scene.heat.wall_coefficient));
+    }
+  }
   return k;
+}
+
+std::vector<double> EnergyBudget::to_vector() const {
+  return {initial, ambient, lamps, dryers, walls, held, lamp_emitted, lamp_escaped};
+}
+
+EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
+  if (v.size() != 8)
+    throw Error("energy budget has " + std::to_string(v.size()) + " entries, expected 8");
+  EnergyBudget b;
+  b.initial = v[0];
+  b.ambient = v[1];
+  b.lamps = v[2];
+  b.dryers = v[3];
+  b.walls = v[4];
+  b.held = v[5];
+  b.lamp_emitted = v[6];
+  b.lamp_escaped = v[7];
+  return b;
 }
 
 Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
@@ -131,6 +179,17 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   grid_.nx = static_cast<int>(std::ceil(ext.x() / grid_.cell)) + 1;
   grid_.ny = static_cast<int>(std::ceil(ext.y() / grid_.cell)) + 1;
   grid_.nz = static_cast<int>(std::ceil(ext.z() / grid_.cell)) + 1;
+  grid_.cells = Eigen::Vector3f::Constant(grid_.cell);
+  // A periodic axis is cut into whole cells of at least H between the domain's faces, so the cells
+  // around one wrap exactly (the scene guarantees at least three).
+  int* counts[3] = {&grid_.nx, &grid_.ny, &grid_.nz};
+  for (int a = 0; a < 3; ++a) {
+    if (!scene.solver.periodic[static_cast<std::size_t>(a)]) continue;
+    const float length = static_cast<float>(scene.domain.max[a] - scene.domain.min[a]);
+    *counts[a] = std::max(3, static_cast<int>(std::floor(length / grid_.cell)));
+    grid_.cells[a] = length / float(*counts[a]);
+    grid_.origin[a] = static_cast<float>(scene.domain.min[a]);
+  }
   const double cells = double(grid_.nx) * grid_.ny * grid_.nz;
   if (cells > double(1u << 28))
     throw SceneError("spacing", "the neighbour grid would need " + std::to_string(cells) +
@@ -168,6 +227,17 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   const auto density = cl.build(with_prelude({"density.cl"}), opts.str());
   const auto forces = cl.build(with_prelude({"forces.cl"}), opts.str());
   const auto integrate = cl.build(with_prelude({"integrate.cl", "step_limits.cl"}), opts.str());
+  heat_ = scene.heat.enabled;
+  if (heat_) {
+    std::string heat_opts = opts.str();
+    for (int a = 0; a < 3; ++a)
+      if (scene.solver.periodic[static_cast<std::size_t>(a)]) heat_opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
+    const auto heat = cl.build(with_prelude({"thermal_law.h", "dryer_model.h", "heat.cl"}), heat_opts);
+    k_thermal_state_ = cl::Kernel(heat, "thermal_state");
+    k_heat_ = cl::Kernel(heat, "heat");
+    k_absorb_ = cl::Kernel(heat, "absorb_photons");
+    k_heat_budget_ = cl::Kernel(heat, "heat_budget");
+  }
   k_cell_keys_ = cl::Kernel(grid, "cell_keys");
   k_hist_ = cl::Kernel(grid, "radix_histogram");
   k_scan_ = cl::Kernel(grid, "radix_scan_rows");
@@ -211,6 +281,38 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   // The padding past the last particle is read by masked lanes only; keep it finite anyway.
   cl.queue().enqueueFillBuffer(soa_, 0.0f, 0, std::size_t(stride_) * 7 * 4);
   cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(stride_) * 2 * 4);
+  enthalpy_ = buf(n * 8);
+  spare_enthalpy_ = buf(n * 8);
+  if (heat_) {
+    const int layers = scene.wall_layers > 0 ? scene.wall_layers
+                                             : static_cast<int>(std::ceil(scene.solver.support_ratio - 1e-9));
+    table_ = material_thermal_table(scene, k_.rest_density, layers);
+    materials_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table_.size() * sizeof(MaterialThermal),
+                            table_.data());
+    thermal_ = buf(std::size_t(stride_) * 3 * 4);
+    cl.queue().enqueueFillBuffer(thermal_, 0.0f, 0, std::size_t(stride_) * 3 * 4);
+    lamp_energy_ = buf(n * 4);
+    cl.queue().enqueueFillBuffer(lamp_energy_, 0.0f, 0, n * 4);
+    hits_ = buf(n * 4);
+    cl.queue().enqueueFillBuffer(hits_, cl_uint(0), 0, n * 4);
+    budget_parts_ = buf(std::size_t(stride_) * 5 * 4);
+    budget_tiles_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 5 * 4);
+    budget_bad_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 4);
+    dryers_ = buf(std::max<std::size_t>(scene.dryers.size(), 1) * sizeof(dryer::DryerJet));
+    if (!scene.lamps.empty()) {
+      // Voxels of one spacing over every particle: a lattice of that spacing puts one particle in each,
+      // at the centre for the lattice through the lowest particle (not on a face, where rounding could
+      // put two in one voxel and leave a hole next to it).
+      VoxelGridInfo vg;
+      vg.cell = static_cast<float>(scene.spacing);
+      vg.origin = lo - Eigen::Vector3f::Constant(1.5f * vg.cell);
+      const Eigen::Vector3f span = hi + Eigen::Vector3f::Constant(vg.cell) - vg.origin;
+      vg.nx = static_cast<int>(std::ceil(span.x() / vg.cell)) + 1;
+      vg.ny = static_cast<int>(std::ceil(span.y() / vg.cell)) + 1;
+      vg.nz = static_cast<int>(std::ceil(span.z() / vg.cell)) + 1;
+      photons_ = std::make_unique<PhotonTracer>(cl, vg);
+    }
+  }
   cell_start_ = buf((std::size_t(ncells_) + 1) * 4);
   clamped_ = buf(4);
   limits_f_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 8);
@@ -231,7 +333,17 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     }
   upload(init);
   if (psi_unknown && scene.solver.boundary_volume == "akinci") compute_boundary_psi();
+  if (heat_) {
+    if (!st.energy_budget.empty()) {
+      budget_ = EnergyBudget::from_vector(st.energy_budget);
+    } else {
+      budget_ = EnergyBudget{};
+      budget_.initial = total_enthalpy();
+    }
+  }
 }
+
+Solver::~Solver() = default;
 
 void Solver::upload(const HostParticles& p) {
   auto& q = cl_.queue();
@@ -242,6 +354,11 @@ void Solver::upload(const HostParticles& p) {
   q.enqueueWriteBuffer(phase_, CL_TRUE, 0, n_, p.phase.data());
   q.enqueueWriteBuffer(material_, CL_TRUE, 0, n_, p.material.data());
   q.enqueueWriteBuffer(id_, CL_TRUE, 0, n_ * 4, p.id.data());
+  if (p.enthalpy.size() == n_) {
+    q.enqueueWriteBuffer(enthalpy_, CL_TRUE, 0, n_ * 8, p.enthalpy.data());
+  } else {
+    q.enqueueFillBuffer(enthalpy_, 0.0f, 0, n_ * 8);
+  }
   const cl_uint zero = 0;
   q.enqueueWriteBuffer(clamped_, CL_TRUE, 0, 4, &zero);
 }
@@ -282,8 +399,9 @@ void Solver::build_grid() {
   // Every per-particle state buffer follows the sort (a new buffer must be added here and to the
   // reorder kernel), in one pass.
   set_args(k_reorder_, order, n, position_, spare_pos_, velocity_, spare_vel_, density_, spare1f_, phase_,
-           spare_phase_, material_, spare_mat_, id_, spare_id_, soa_, stride_);
+           spare_phase_, material_, spare_mat_, id_, spare_id_, enthalpy_, spare_enthalpy_, soa_, stride_);
   launch(q, k_reorder_, n_);
+  std::swap(enthalpy_, spare_enthalpy_);
   std::swap(position_, spare_pos_);
   std::swap(velocity_, spare_vel_);
   std::swap(density_, spare1f_);
@@ -293,6 +411,7 @@ void Solver::build_grid() {
 
   set_args(k_starts_, keys, cell_start_, n, ncells_);
   launch(q, k_starts_, n_ + 1);
+  grid_built_ = true;
 }
 
 void Solver::compute_boundary_psi() {
@@ -328,8 +447,30 @@ void Solver::compute_forces() {
   launch(cl_.queue(), k_forces_, n_);
 }
 
+double Solver::heat_time_step() const {
+  if (!heat_) return std::numeric_limits<double>::infinity();
+  double dt = std::min(k_.diffusion_dt, k_.wall_dt);
+  double h_air = scene_.heat.ambient_coefficient;
+  for (const Dryer& d : scene_.dryers)
+    if (d.on && d.speed > 0)
+      h_air += dryer::dryer_coefficient(static_cast<float>(d.nozzle_diameter)) * std::sqrt(d.speed);
+  if (h_air > 0) dt = std::min(dt, 0.5 * k_.exposed_capacity / (scene_.heat.time_scale * h_air));
+  return dt;
+}
+
 double Solver::choose_time_step() {
   const auto& s = scene_.solver;
+  if (!s.flow) {
+    // Nothing moves: only heat limits the step.
+    double dt = static_cast<float>(std::min(s.max_dt, heat_time_step()));
+    if (dt < s.min_dt) {
+      std::ostringstream os;
+      os << "step " << steps_ + 1 << " (t = " << time_ << " s): the heat time step " << dt
+         << " s is below solver.min_dt = " << s.min_dt << " s; lower heat.time_scale or coarsen the spacing";
+      throw BlowUpError(os.str());
+    }
+    return dt;
+  }
   double vmax2 = 0, amax2 = 0;
   std::uint32_t fastest = 0, bad = 0xffffffffu;
   if (n_ > 0) {
@@ -384,14 +525,119 @@ double Solver::choose_time_step() {
   dt = std::min(dt, s.cfl * h / (k_.sound_speed + vmax));  // CFL (acoustic + advective)
   if (amax2 > 0) dt = std::min(dt, s.force_number * std::sqrt(h / std::sqrt(amax2)));
   if (k_.kinematic_viscosity > 0) dt = std::min(dt, s.viscous_number * h * h / k_.kinematic_viscosity);
+  const double dt_heat = heat_time_step();
+  dt = std::min(dt, dt_heat);
   dt = static_cast<float>(dt);  // the kernels see a float: keep host time consistent with them
   if (dt < s.min_dt) {
     std::ostringstream os;
     os << where() << "the adaptive time step fell to " << dt << " s, below solver.min_dt = " << s.min_dt
-       << " s (max acceleration " << std::sqrt(amax2) << " m/s^2, max speed " << vmax << " m/s)" << advice;
+       << " s (max acceleration " << std::sqrt(amax2) << " m/s^2, max speed " << vmax << " m/s, heat limit "
+       << dt_heat << " s)" << advice;
     throw BlowUpError(os.str());
   }
   return dt;
+}
+
+void Solver::trace_photons(double dt) {
+  if (!photons_ || n_ == 0) return;
+  photons_->build_occupancy(position_, phase_, static_cast<std::uint32_t>(n_));
+  for (std::size_t l = 0; l < scene_.lamps.size(); ++l) {
+    const Lamp& lamp = scene_.lamps[l];
+    if (!lamp.on) continue;
+    // The rectangle's width runs horizontally (across the normal and z) where it can.
+    const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+    Eigen::Vector3d u = lamp.normal.cross(z);
+    u = u.norm() > 1e-6 ? u.normalized() : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d v = lamp.normal.cross(u);
+    LampGeometry geo;
+    geo.centre = lamp.centre.cast<float>();
+    geo.normal = lamp.normal.cast<float>();
+    geo.half_u = (0.5 * lamp.width * u).cast<float>();
+    geo.half_v = (0.5 * lamp.height * v).cast<float>();
+    const auto photons = static_cast<std::uint32_t>(lamp.photons);
+    const double energy = photon_energy(lamp.emissivity, lamp.temperature, lamp.width * lamp.height,
+                                        scene_.heat.time_scale * dt, photons);
+    const PhotonTally tally = photons_->trace(geo, photons, steps_, static_cast<std::uint32_t>(l), hits_);
+    const float e = static_cast<float>(energy);
+    set_args(k_absorb_, hits_, lamp_energy_, e, static_cast<cl_uint>(n_));
+    launch(cl_.queue(), k_absorb_, n_);
+    budget_.lamp_emitted += double(e) * double(tally.emitted);
+    budget_.lamp_escaped += double(e) * double(tally.escaped());
+  }
+}
+
+void Solver::upload_dryers() {
+  std::vector<dryer::DryerJet> jets;
+  for (const Dryer& d : scene_.dryers) {
+    dryer::DryerJet j{};
+    j.px = float(d.position.x());
+    j.py = float(d.position.y());
+    j.pz = float(d.position.z());
+    j.dx = float(d.direction.x());
+    j.dy = float(d.direction.y());
+    j.dz = float(d.direction.z());
+    j.half_angle = float(d.half_angle * M_PI / 180.0);
+    j.reach = float(d.reach);
+    j.temperature = float(d.temperature);
+    j.speed = d.on ? float(d.speed) : 0.0f;
+    j.diameter = float(d.nozzle_diameter);
+    j.coefficient = dryer::dryer_coefficient(j.diameter);
+    jets.push_back(j);
+  }
+  if (!jets.empty())
+    cl_.queue().enqueueWriteBuffer(dryers_, CL_TRUE, 0, jets.size() * sizeof(dryer::DryerJet), jets.data());
+  dryers_dirty_ = false;
+}
+
+void Solver::compute_heat(double dt) {
+  if (!heat_ || n_ == 0) return;
+  auto& q = cl_.queue();
+  const auto n = static_cast<cl_uint>(n_);
+  set_args(k_thermal_state_, position_, density_, enthalpy_, phase_, material_, materials_, k_.rest_density,
+           static_cast<cl_int>(scene_.solver.flow ? 1 : 0), thermal_, stride_, n);
+  launch(q, k_thermal_state_, n_);
+  if (dryers_dirty_) upload_dryers();
+  const ClGrid g = cl_grid(grid_);
+  cl_float4 period{{0.f, 0.f, 0.f, 0.f}};
+  for (int a = 0; a < 3; ++a)
+    if (scene_.solver.periodic[static_cast<std::size_t>(a)])
+      period.s[a] = static_cast<float>(scene_.domain.max[a] - scene_.domain.min[a]);
+  const float dx = static_cast<float>(scene_.spacing);
+  const float h = k_.smoothing;
+  // Iwasaki's voxel faces: a neighbour within 1.2 spacings covers one (lattice face neighbours sit at
+  // 1, edge neighbours at 1.41 spacings).
+  const float exposed_r2 = 1.44f * dx * dx;
+  set_args(k_heat_, position_, velocity_, enthalpy_, phase_, material_, materials_, soa_, thermal_, stride_,
+           cell_start_, g, k_.support, 0.01f * h * h, period, exposed_r2, dx * dx,
+           static_cast<float>(scene_.heat.ambient_temperature), static_cast<float>(scene_.heat.ambient_coefficient),
+           dryers_, static_cast<cl_uint>(scene_.dryers.size()), lamp_energy_,
+           static_cast<float>(scene_.heat.time_scale * dt), budget_parts_, n);
+  launch(q, k_heat_, n_);
+  set_args(k_heat_budget_, budget_parts_, enthalpy_, stride_, budget_tiles_, budget_bad_, n, tile_);
+  q.enqueueNDRangeKernel(k_heat_budget_, cl::NullRange, global_for(ntiles_));
+  std::vector<float> sums(std::size_t(ntiles_) * 5);
+  std::vector<cl_uint> bad(ntiles_);
+  q.enqueueReadBuffer(budget_tiles_, CL_FALSE, 0, sums.size() * 4, sums.data());
+  q.enqueueReadBuffer(budget_bad_, CL_TRUE, 0, bad.size() * 4, bad.data());
+  for (std::uint32_t t = 0; t < ntiles_; ++t) {
+    if (bad[t] != 0xffffffffu) {
+      Float4 x;
+      std::uint32_t id = 0;
+      q.enqueueReadBuffer(position_, CL_TRUE, bad[t] * 16, 16, x.data());
+      q.enqueueReadBuffer(id_, CL_TRUE, bad[t] * 4, 4, &id);
+      std::ostringstream os;
+      os << "step " << steps_ + 1 << " (t = " << time_ << " s): particle " << id << " at (" << x[0] << ", " << x[1]
+         << ", " << x[2] << ") m has a non-finite enthalpy; lower solver.max_dt or heat.time_scale, or tame the "
+         << "heat sources";
+      throw BlowUpError(os.str());
+    }
+    const float* t5 = &sums[std::size_t(t) * 5];
+    budget_.ambient += t5[0];
+    budget_.lamps += t5[1];
+    budget_.dryers += t5[2];
+    budget_.walls += t5[3];
+    budget_.held += t5[4];
+  }
 }
 
 void Solver::integrate(double dt) {
@@ -402,12 +648,20 @@ void Solver::integrate(double dt) {
 }
 
 void Solver::step() {
-  timed(Stage::Grid, [&] { build_grid(); });
-  timed(Stage::Density, [&] { compute_density(); });
-  timed(Stage::Forces, [&] { compute_forces(); });
+  const bool flow = scene_.solver.flow;
+  // Without flow nothing moves: one sort serves the whole run.
+  if (flow || !grid_built_) timed(Stage::Grid, [&] { build_grid(); });
+  if (flow) {
+    timed(Stage::Density, [&] { compute_density(); });
+    timed(Stage::Forces, [&] { compute_forces(); });
+  }
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
-  timed(Stage::Integrate, [&] { integrate(dt); });
+  if (heat_) {
+    timed(Stage::Photons, [&] { trace_photons(dt); });
+    timed(Stage::Heat, [&] { compute_heat(dt); });
+  }
+  if (flow) timed(Stage::Integrate, [&] { integrate(dt); });
   time_ += dt;
   dt_ = dt;
   ++steps_;
@@ -420,7 +674,73 @@ void Solver::warm_up() {
   compute_forces();
   choose_time_step();
   integrate(0.0);
+  if (heat_) {
+    // dt = 0 adds no heat; the budget's sums of zero leave it unchanged.
+    if (photons_) photons_->warm_up();
+    compute_heat(0.0);
+  }
   cl_.queue().finish();
+}
+
+void Solver::set_dryer(std::size_t index, const Dryer& d) {
+  if (index >= scene_.dryers.size())
+    throw Error("dryer " + std::to_string(index) + " does not exist; the scene has " +
+                std::to_string(scene_.dryers.size()));
+  const std::string path = "dryers[" + std::to_string(index) + "]";
+  Json j = {{"on", d.on},
+            {"position", {d.position.x(), d.position.y(), d.position.z()}},
+            {"direction", {d.direction.x(), d.direction.y(), d.direction.z()}},
+            {"half_angle", d.half_angle},
+            {"reach", d.reach},
+            {"temperature", d.temperature},
+            {"speed", d.speed},
+            {"nozzle_diameter", d.nozzle_diameter}};
+  validate(j, *find_field(scene_schema(), "dryers[0]"), path);
+  if (d.direction.norm() == 0.0) throw SceneError(path + ".direction", "must not be zero");
+  Dryer checked = d;
+  checked.direction.normalize();
+  scene_.dryers[index] = checked;
+  dryers_dirty_ = true;
+}
+
+void Solver::set_lamp(std::size_t index, const Lamp& l) {
+  if (index >= scene_.lamps.size())
+    throw Error("lamp " + std::to_string(index) + " does not exist; the scene has " +
+                std::to_string(scene_.lamps.size()));
+  const std::string path = "lamps[" + std::to_string(index) + "]";
+  Json j = {{"on", l.on},
+            {"centre", {l.centre.x(), l.centre.y(), l.centre.z()}},
+            {"normal", {l.normal.x(), l.normal.y(), l.normal.z()}},
+            {"width", l.width},
+            {"height", l.height},
+            {"temperature", l.temperature},
+            {"emissivity", l.emissivity},
+            {"photons", l.photons}};
+  validate(j, *find_field(scene_schema(), "lamps[0]"), path);
+  if (l.normal.norm() == 0.0) throw SceneError(path + ".normal", "must not be zero");
+  Lamp checked = l;
+  checked.normal.normalize();
+  scene_.lamps[index] = checked;
+}
+
+double Solver::total_enthalpy() const {
+  if (!heat_ || n_ == 0) return 0.0;
+  const HostParticles p = particles();
+  double sum = 0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    const double mass = double(p.position[i][3]) * table_[p.material[i]].thermal_mass_scale;
+    sum += mass * (double(p.enthalpy[i][0]) + double(p.enthalpy[i][1]));
+  }
+  return sum;
+}
+
+std::vector<float> Solver::temperatures() const {
+  std::vector<float> out(n_, 0.0f);
+  if (!heat_ || n_ == 0) return out;
+  const HostParticles p = particles();
+  for (std::size_t i = 0; i < n_; ++i)
+    out[i] = static_cast<float>(temperature_at(table_[p.material[i]], double(p.enthalpy[i][0]) + p.enthalpy[i][1]));
+  return out;
 }
 
 std::uint64_t Solver::clamped() const {
@@ -439,6 +759,7 @@ HostParticles Solver::particles() const {
   q.enqueueReadBuffer(density_, CL_FALSE, 0, n_ * 4, p.density.data());
   q.enqueueReadBuffer(phase_, CL_FALSE, 0, n_, p.phase.data());
   q.enqueueReadBuffer(material_, CL_FALSE, 0, n_, p.material.data());
+  q.enqueueReadBuffer(enthalpy_, CL_FALSE, 0, n_ * 8, p.enthalpy.data());
   q.enqueueReadBuffer(id_, CL_TRUE, 0, n_ * 4, p.id.data());
   return p;
 }
@@ -451,6 +772,7 @@ SimState Solver::state() const {
   s.dt = dt_;
   s.clamped = clamped();
   s.scene_json = scene_.source.dump();
+  if (heat_) s.energy_budget = budget_.to_vector();
   return s;
 }
 

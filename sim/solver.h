@@ -1,10 +1,14 @@
 #pragma once
-// Weakly compressible SPH water with static boundary particles, stepped on an OpenCL device.
-// One step (see Solver::step): grid -> density -> forces -> time step -> integrate.
+// Weakly compressible SPH water with static boundary particles, and heat with phase change, stepped on an
+// OpenCL device. One step (see Solver::step): grid -> density -> forces -> time step -> photons -> heat ->
+// integrate; a scene without heat builds no heat stages, one with the flow off none of the fluid ones.
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "sim/cl_runtime.h"
+#include "sim/kernels/thermal_law.h"
 #include "sim/particles.h"
 #include "sim/scene.h"
 #include "sim/stage_timers.h"
@@ -24,13 +28,33 @@ struct SolverConstants {
   // Viscosity coefficients of the forces pass: 2(d+2) nu + alpha c h between fluid particles (Monaghan
   // 2005 eq. 4.8 and its artificial-viscosity equivalent), alpha_b c h against boundary particles.
   float visc_fluid = 0, visc_boundary = 0;
+  // Heat: the diffusion limit on dt [s] (infinite without conduction), and the smallest heat capacity
+  // per exposed area rho c dx / 6 over the materials that exchange heat with the air [J/m^2/K].
+  double diffusion_dt = 0;
+  double exposed_capacity = 0;
+  double wall_dt = 0;  // the tank walls' exchange limit on dt [s] (infinite without wall heat)
 };
+
+// The run's energy account [J]: enthalpy at the start and the heat that came in since, by source.
+// Closure: total enthalpy now - initial - heat_in() is round-off (conduction and phase change move
+// heat only between particles).
+struct EnergyBudget {
+  double initial = 0;
+  double ambient = 0, lamps = 0, dryers = 0, walls = 0, held = 0;
+  double lamp_emitted = 0, lamp_escaped = 0;  // photons: emitted = absorbed (lamps) + escaped
+  double heat_in() const { return ambient + lamps + dryers + walls + held; }
+  std::vector<double> to_vector() const;
+  static EnergyBudget from_vector(const std::vector<double>& v);  // throws Error on a wrong length
+};
+
+class PhotonTracer;
 SolverConstants derive_constants(const Scene& scene);
 
 class Solver {
  public:
   // Starts from a state: a fresh one from initial_state(), or one read from a state file.
   Solver(ClRuntime& cl, const Scene& scene, const SimState& state);
+  ~Solver();
 
   // One time step. Throws BlowUpError naming the step and the particle when the state is not finite
   // or runs away, or when the adaptive time step collapses below the scene's min_dt.
@@ -42,6 +66,18 @@ class Solver {
 
   // Velocity relaxation rate zeta [1/s] for settling an initial state (validation cases); 0 = none.
   void set_velocity_damping(double zeta) { damping_ = zeta; }
+
+  // Heat sources a running simulation may change (the server calls these between steps). Values are
+  // checked like the scene's (Error naming the field on a bad one); index out of range is an Error.
+  void set_dryer(std::size_t index, const Dryer& dryer);
+  void set_lamp(std::size_t index, const Lamp& lamp);
+  const std::vector<Dryer>& dryers() const { return scene_.dryers; }
+  const std::vector<Lamp>& lamps() const { return scene_.lamps; }
+
+  // Heat accounting: the total enthalpy sum m h over all particles now (double, read from the device),
+  // and the budget so far.
+  double total_enthalpy() const;
+  const EnergyBudget& energy_budget() const { return budget_; }
 
   SimState state() const;  // copies the device state to the host
   HostParticles particles() const;
@@ -63,6 +99,8 @@ class Solver {
   void compute_density();
   void compute_forces();
   double choose_time_step();
+  void trace_photons(double dt);  // lamps: photons absorbed this step, as energy per particle
+  void compute_heat(double dt);   // conduction, sources, enthalpy update, phase change, budget
   void integrate(double dt);
 
   // Cell geometry of the neighbour grid (for reference loops and tests).
@@ -70,16 +108,20 @@ class Solver {
     Eigen::Vector3f origin;
     float cell = 0;
     int nx = 0, ny = 0, nz = 0;
+    Eigen::Vector3f cells = Eigen::Vector3f::Zero();  // cell size per axis: `cell`, or a periodic axis's
     int reach = 1;  // cells visited on each side
   };
   const GridInfo& grid() const { return grid_; }
   std::vector<std::uint32_t> cell_starts() const;
   std::vector<float> densities() const;
   std::vector<Float4> pressure_state() const;  // per particle (rho, p/rho^2, is_boundary, p)
+  std::vector<float> temperatures() const;     // per particle [°C], from the last heat stage's state
 
  private:
   void compute_boundary_psi();
   void upload(const HostParticles& p);
+  void upload_dryers();
+  double heat_time_step() const;
   template <class F>
   void timed(Stage s, F&& f);
 
@@ -110,6 +152,19 @@ class Solver {
 
   cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_, k_reorder_;
   cl::Kernel k_psi_, k_set_mass_, k_density_, k_forces_, k_limits_, k_integrate_;
+
+  // Heat (built only when scene.heat.enabled): enthalpy (hi, lo) per particle, reordered with the rest;
+  // the material table; T, k, V blocks for the neighbour loop; absorbed lamp energy; photon hits; the
+  // per-particle energies of the budget and their per-tile sums.
+  bool heat_ = false;
+  bool grid_built_ = false;
+  std::vector<thermal::MaterialThermal> table_;
+  EnergyBudget budget_;
+  cl::Buffer enthalpy_, spare_enthalpy_, materials_, thermal_, lamp_energy_, hits_, budget_parts_, budget_tiles_,
+      budget_bad_, dryers_;
+  bool dryers_dirty_ = true;
+  std::unique_ptr<PhotonTracer> photons_;
+  cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_heat_budget_;
 };
 
 // Samples a scene into particles: fluid blocks on a lattice, static solids and domain walls as

@@ -7,9 +7,9 @@
 
 namespace thaw {
 
-enum class Stage { Grid, Density, Forces, TimeStep, Integrate, Count };
+enum class Stage { Grid, Density, Forces, TimeStep, Photons, Heat, Integrate, Count };
 inline constexpr std::array<const char*, static_cast<int>(Stage::Count)> kStageNames = {
-    "grid", "density", "forces", "time_step", "integrate"};
+    "grid", "density", "forces", "time_step", "photons", "heat", "integrate"};
 
 class StageTimers {
  public:

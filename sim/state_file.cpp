@@ -24,6 +24,9 @@ namespace {
 constexpr std::array<char, 8> kMagic = {'\x89', 'T', 'H', 'A', 'W', '\r', '\n', '\x1a'};
 constexpr std::uint32_t kByteOrderMark = 0x01020304;
 constexpr std::uint32_t kSectionRequired = 1;
+// A section of the run as a whole (its count is its own, not the particle count).
+constexpr std::uint32_t kSectionGlobal = 2;
+constexpr const char* kEnergySection = "energy_budget";
 constexpr std::size_t kPrefixBytes = 8 + 4 + 4;  // magic, version, byte order: the same in every version
 constexpr std::size_t kHeaderBytes = kPrefixBytes + 7 * 8 + 2 * 4 + 8;
 constexpr std::size_t kTrailerBytes = 8;
@@ -121,7 +124,7 @@ std::string hex(std::uint64_t v) {
 // Width of the scalars an element is made of, for byte order: a Float4 is four 4-byte words.
 template <typename T>
 constexpr std::size_t word_size() {
-  if constexpr (std::is_same_v<T, Float4>) {
+  if constexpr (std::is_same_v<T, Float4> || std::is_same_v<T, Float2>) {
     return sizeof(float);
   } else {
     static_assert(std::is_arithmetic_v<T>, "a section element is a scalar or a Float4");
@@ -140,6 +143,7 @@ void for_each_array(Particles& p, Visit&& visit) {
   visit("phase", p.phase);
   visit("material", p.material);
   visit("id", p.id);
+  visit("enthalpy", p.enthalpy);
 }
 
 // The arrays of one HostParticles must agree in length before they are written.
@@ -162,6 +166,10 @@ std::string encode_state(const SimState& s) {
     ++sections;
     body += 4 + std::strlen(name) + 4 + 4 + 8 + array.size() * sizeof(array[0]);
   });
+  if (!s.energy_budget.empty()) {
+    ++sections;
+    body += 4 + std::strlen(kEnergySection) + 4 + 4 + 8 + s.energy_budget.size() * 8;
+  }
   const std::size_t total = kHeaderBytes + s.scene_json.size() + body + kTrailerBytes;
 
   ByteWriter w;
@@ -191,6 +199,15 @@ std::string encode_state(const SimState& s) {
     w.u64(array.size());
     w.words(array.data(), array.size() * sizeof(Element), word_size<Element>());
   });
+  if (!s.energy_budget.empty()) {
+    const std::size_t name_length = std::strlen(kEnergySection);
+    w.u32(static_cast<std::uint32_t>(name_length));
+    w.bytes(std::string_view(kEnergySection, name_length));
+    w.u32(kSectionRequired | kSectionGlobal);
+    w.u32(8);
+    w.u64(s.energy_budget.size());
+    w.words(s.energy_budget.data(), s.energy_budget.size() * 8, 8);
+  }
   w.u64(fnv1a64(w.buffer()));
   return std::move(w.buffer());
 }
@@ -318,6 +335,14 @@ SimState decode_state(const std::string& path, std::string_view data) {
     seen.push_back(name);
 
     bool known = false;
+    if (name == kEnergySection && (flags & kSectionGlobal)) {
+      if (element_size != 8)
+        throw file_error(path, "section '" + name + "' has elements of " + std::to_string(element_size) +
+                                   " bytes, expected 8");
+      known = true;
+      s.energy_budget.resize(static_cast<std::size_t>(count));
+      copy_little_endian(reinterpret_cast<char*>(s.energy_budget.data()), payload.data(), payload.size(), 8);
+    }
     for_each_array(s.particles, [&](const char* array_name, auto& array) {
       using Element = std::remove_cvref_t<decltype(array[0])>;
       if (name != array_name) return;

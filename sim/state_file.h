@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "sim/particles.h"
 
@@ -41,6 +42,9 @@ struct SimState {
   double dt = 0.0;            // last time step [s]
   std::uint64_t clamped = 0;  // particles clamped back into the domain so far
   std::string scene_json;     // the resolved scene document the run used
+  // The run's energy account [J] (sim/solver.h, EnergyBudget::to_vector); empty without heat. Stored as
+  // the section "energy_budget" (flags: required, global), whose count is its own.
+  std::vector<double> energy_budget;
 };
 
 // Writes `state` to `path` atomically and durably; throws thaw::Error naming the path and the reason.

@@ -6,25 +6,6 @@
  * forces pass's pair terms: derived = (k_j m_j / rho_j, m_j p_j / rho_j^2) blocks, k_j the viscosity
  * coefficient of the particle's kind (fluid or boundary). */
 
-/* The smoothing kernel of sph_kernel.h on lanes, with its normalisation sigma factored out of the sum:
- * W(q H, H) = sigma w_shape(q) for q = r / H in [0, 1) (lanes outside the support are masked). */
-#ifdef THAW_WENDLAND
-#define THAW_SIGMA(H) (21.0f / (2.0f * THAW_PI_F * (H) * (H) * (H)))
-floatV w_shape(floatV q) {
-  q = fmin(q, 1.0f);
-  const floatV a = 1.0f - q;
-  return a * a * a * a * (1.0f + 4.0f * q);
-}
-#else
-#define THAW_SIGMA(H) (8.0f / (THAW_PI_F * (H) * (H) * (H)))
-floatV w_shape(floatV q) {
-  const floatV a = 1.0f - q;
-  const floatV inner = 6.0f * q * q * (q - 1.0f) + 1.0f;
-  const floatV outer = 2.0f * a * a * a;
-  return select(outer, inner, q <= 0.5f);
-}
-#endif
-
 kernel void density(global const float4* pos, global const float* soa, const uint stride,
                     global const uchar* phase, global const uint* cell_start, const Grid g, const float H,
                     const float rho0, const float B, const float gamma_eos, const float visc_fluid,
@@ -69,7 +50,7 @@ kernel void density(global const float4* pos, global const float* soa, const uin
 #endif
   /* No tension: clamping keeps free-surface particles from clumping (tensile instability). */
   p = fmax(p, 0.0f);
-  const int boundary = phase[i] == THAW_PHASE_SOLID;
+  const int boundary = THAW_IS_STATIC(phase[i]);
   const float dp = p / (rho * rho);
   density[i] = rho;
   state[i] = (float4)(rho, dp, boundary ? 1.0f : 0.0f, p);

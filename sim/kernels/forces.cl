@@ -11,33 +11,13 @@
  * structure-of-arrays copy (x, y, z, m, vx, vy, vz) and the per-particle factors the density pass
  * wrote (derived: k_j m_j / rho_j, m_j p_j / rho_j^2). */
 
-/* The kernel gradient of sph_kernel.h on lanes, its normalisation factored out of the sum:
- * grad_factor(q H, H) = sigma / H^2 grad_shape(q) for q = r / H in [0, 1) (lanes outside the support
- * are masked). */
-#ifdef THAW_WENDLAND
-#define THAW_SIGMA(H) (21.0f / (2.0f * THAW_PI_F * (H) * (H) * (H)))
-floatV grad_shape(floatV q) {
-  q = fmin(q, 1.0f);
-  const floatV a = 1.0f - q;
-  return -20.0f * a * a * a;
-}
-#else
-#define THAW_SIGMA(H) (8.0f / (THAW_PI_F * (H) * (H) * (H)))
-floatV grad_shape(floatV q) {
-  const floatV a = 1.0f - q;
-  const floatV inner = 18.0f * q - 12.0f;
-  /* -6 sigma a^2 / (H r) = sigma / H^2 (-6 a^2 / q), only taken for q > 0.5 */
-  const floatV outer = -6.0f * a * a / fmax(q, 0.25f);
-  return select(outer, inner, q <= 0.5f);
-}
-#endif
 kernel void forces(global const float4* pos, global const float4* vel, global const float* soa,
                    global const float* derived, const uint stride, global const float4* state,
                    global const uchar* phase, global const uint* cell_start, const Grid g, const float H,
                    const float4 gravity, const float eps2, global float4* accel, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
-  if (phase[i] == THAW_PHASE_SOLID) {
+  if (THAW_IS_STATIC(phase[i])) {
     accel[i] = (float4)(0.0f);
     return;
   }

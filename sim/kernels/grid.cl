@@ -9,7 +9,7 @@ kernel void cell_keys(global float4* pos, global float4* vel, global const uchar
   const uint i = get_global_id(0);
   if (i >= n) return;
   float4 p = pos[i];
-  if (phase[i] != THAW_PHASE_SOLID) {
+  if (!THAW_IS_STATIC(phase[i])) {
     const int4 below = isless(p, dmin);
     const int4 above = isgreater(p, dmax);
     if (any(below.xyz) || any(above.xyz)) {
@@ -95,7 +95,8 @@ kernel void reorder(global const uint* order, const uint n, global const float4*
                     global float4* pos_out, global const float4* vel_in, global float4* vel_out,
                     global const float* rho_in, global float* rho_out, global const uchar* phase_in,
                     global uchar* phase_out, global const uchar* material_in, global uchar* material_out,
-                    global const uint* id_in, global uint* id_out, global float* soa, const uint stride) {
+                    global const uint* id_in, global uint* id_out, global const float2* enthalpy_in,
+                    global float2* enthalpy_out, global float* soa, const uint stride) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   const uint s = order[i];
@@ -107,6 +108,7 @@ kernel void reorder(global const uint* order, const uint n, global const float4*
   phase_out[i] = phase_in[s];
   material_out[i] = material_in[s];
   id_out[i] = id_in[s];
+  enthalpy_out[i] = enthalpy_in[s];
   soa[i] = p.x;
   soa[stride + i] = p.y;
   soa[2 * stride + i] = p.z;

@@ -13,7 +13,7 @@ kernel void step_limits(global const float4* pos, global const float4* vel, glob
   float vmax = 0.0f, amax = 0.0f;
   uint arg = b, bad = 0xffffffffu;
   for (uint i = b; i < e; ++i) {
-    if (phase[i] == THAW_PHASE_SOLID) continue;
+    if (THAW_IS_STATIC(phase[i])) continue;
     const float v2 = dot(vel[i].xyz, vel[i].xyz);
     const float a2 = dot(accel[i].xyz, accel[i].xyz);
     const float x2 = dot(pos[i].xyz, pos[i].xyz);

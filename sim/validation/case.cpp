@@ -27,7 +27,8 @@ Json CaseResult::to_json() const {
 }
 
 const std::vector<ValidationCase>& validation_cases() {
-  static const std::vector<ValidationCase> cases = {hydrostatic_case(), dam_break_case()};
+  static const std::vector<ValidationCase> cases = {hydrostatic_case(), dam_break_case(), conduction_case(),
+                                                      stefan_case()};
   return cases;
 }
 

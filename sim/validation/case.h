@@ -48,6 +48,8 @@ Json case_parameters(const ValidationCase& c, const std::vector<std::string>& ov
 // The cases, one file each.
 ValidationCase hydrostatic_case();
 ValidationCase dam_break_case();
+ValidationCase conduction_case();
+ValidationCase stefan_case();
 
 }  // namespace thaw
 

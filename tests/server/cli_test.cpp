@@ -28,8 +28,8 @@ Json small_scene() {
     "domain": {"min": [0, 0, 0], "max": [0.2, 0.1, 0.2], "walls": ["-z"], "wall_material": "glass"},
     "spacing": 0.02,
     "materials": {
-      "water": {"kind": "fluid", "density": 1000, "viscosity": 1e-3},
-      "glass": {"kind": "solid", "density": 2500}
+      "water": {"kind": "fluid", "density": 1000, "viscosity": 1e-3, "conductivity": 0.56, "specific_heat": 4217},
+      "glass": {"kind": "solid", "density": 2500, "conductivity": 1.0, "specific_heat": 840}
     },
     "fluids": [{"material": "water", "box": {"min": [0, 0, 0], "max": [0.1, 0.1, 0.1]}}]
   })");

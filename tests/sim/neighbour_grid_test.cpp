@@ -32,7 +32,9 @@ Scene grid_scene(double spacing = 0.03125, Eigen::Vector3d max = {0.5, 0.375, 0.
       {"domain", {{"min", {0.0, 0.0, 0.0}}, {"max", {max.x(), max.y(), max.z()}}}},
       {"gravity", {0.0, 0.0, -9.81}},
       {"spacing", spacing},
-      {"materials", {{"water", {{"kind", "fluid"}, {"density", kRho0}, {"viscosity", 1e-3}}}}},
+      {"materials",
+       {{"water",
+         {{"kind", "fluid"}, {"density", kRho0}, {"viscosity", 1e-3}, {"conductivity", 0.56}, {"specific_heat", 4217}}}}},
       {"fluids",
        {{{"material", "water"}, {"box", {{"min", {0.0, 0.0, 0.0}}, {"max", {0.125, 0.125, 0.125}}}}}}},
   };

@@ -23,8 +23,8 @@ Json base_scene() {
     "domain": {"min": [0, 0, 0], "max": [0.4, 0.2, 0.3], "walls": ["-x", "+x", "-z"], "wall_material": "glass"},
     "spacing": 0.01,
     "materials": {
-      "water": {"kind": "fluid", "density": 1000, "viscosity": 1e-3},
-      "glass": {"kind": "solid", "density": 2500}
+      "water": {"kind": "fluid", "density": 1000, "viscosity": 1e-3, "conductivity": 0.56, "specific_heat": 4217},
+      "glass": {"kind": "solid", "density": 2500, "conductivity": 1.0, "specific_heat": 840}
     },
     "fluids": [
       {"material": "water", "box": {"min": [0, 0, 0], "max": [0.1, 0.1, 0.1]}},
@@ -69,7 +69,7 @@ TEST(Scene, EveryShippedConfigLoads) {
     EXPECT_NO_THROW({
       const Scene s = load_scene(entry.path().string());
       EXPECT_FALSE(s.name.empty());
-      EXPECT_FALSE(s.fluids.empty());
+      EXPECT_FALSE(s.fluids.empty() && s.ice.empty());
     });
     ++count;
   }

@@ -65,7 +65,9 @@ SimState make_state(std::size_t n) {
     s.particles.phase[i] = static_cast<std::uint8_t>(i % kPhaseCount);
     s.particles.material[i] = static_cast<std::uint8_t>(i * 37 % 256);
     s.particles.id[i] = static_cast<std::uint32_t>((n - 1 - i) * 2654435761u);
+    s.particles.enthalpy[i] = {334000.0f - 1000.0f * f, 1e-3f * f};
   }
+  if (n > 0) s.energy_budget = {1.5e6, -2.0, 3.0, 0.25, -1e-9, 0.0, 7.0, 4.0};
   return s;
 }
 
@@ -86,6 +88,8 @@ void expect_bit_identical(const SimState& a, const SimState& b) {
   EXPECT_TRUE(same_bytes(a.particles.phase, b.particles.phase));
   EXPECT_TRUE(same_bytes(a.particles.material, b.particles.material));
   EXPECT_TRUE(same_bytes(a.particles.id, b.particles.id));
+  EXPECT_TRUE(same_bytes(a.particles.enthalpy, b.particles.enthalpy));
+  EXPECT_TRUE(same_bytes(a.energy_budget, b.energy_budget));
 }
 
 // Builds version-1 files section by section, independently of the writer, so tests can make files the
@@ -111,14 +115,18 @@ class FileBuilder {
     if (name == "density") return {name, 1, 4, n, raw(p.density)};
     if (name == "phase") return {name, 1, 1, n, raw(p.phase)};
     if (name == "material") return {name, 1, 1, n, raw(p.material)};
+    if (name == "enthalpy") return {name, 1, 8, n, raw(p.enthalpy)};
+    // The run-wide energy account: flags required | global, its own count.
+    if (name == "energy_budget") return {name, 3, 8, s.energy_budget.size(), raw(s.energy_budget)};
     return {name, 1, 4, n, raw(p.id)};
   }
 
   static std::vector<Section> sections_of(const SimState& s) {
     std::vector<Section> out;
-    for (const char* name : {"position", "velocity", "density", "phase", "material", "id"}) {
+    for (const char* name : {"position", "velocity", "density", "phase", "material", "id", "enthalpy"}) {
       out.push_back(section_of(s, name));
     }
+    if (!s.energy_budget.empty()) out.push_back(section_of(s, "energy_budget"));
     return out;
   }
 
@@ -344,7 +352,7 @@ TEST_F(StateFileTest, UnknownOptionalSectionIsSkipped) {
 TEST_F(StateFileTest, MissingSectionIsNamed) {
   const SimState state = make_state(5);
   auto sections = FileBuilder::sections_of(state);
-  sections.pop_back();
+  sections.erase(sections.begin() + 5);  // id
   const fs::path path = dir_ / "noid.state";
   write_bytes(path, FileBuilder::build(state, sections));
   EXPECT_ERROR_NAMES(read_error(path), path, "missing required section 'id'");

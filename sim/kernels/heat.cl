@@ -1,0 +1,238 @@
+/* Heat: conduction between all particles, the exposed surface's exchange with the ambient air and the
+ * dryers, the tank walls' exchange with the outside, absorbed lamp photons, and the phase change that
+ * follows from each particle's enthalpy (thermal_law.h). Built with thermal_law.h and dryer_model.h.
+ *
+ * Conduction is the pairwise form of Cleary & Monaghan (1999, eq. 9; Brookshaw 1985) with the harmonic
+ * mean of the two conductivities, not the kernel Laplacian of Iwasaki et al. (2010) eq. 1, which is off by
+ * 10-20 % in effective diffusivity on lattices and unstable on disordered particles (VALIDATION.md sec. 1):
+ *   Q_i = 2 V_i sum_j V_j k_ij (T_i - T_j) (x_ij . grad W_ij) / (r_ij^2 + eta^2),
+ *   k_ij = 2 k_i k_j / (k_i + k_j),
+ * the heat flow into particle i [W]. Each pair's term is antisymmetric, so conduction conserves the total
+ * enthalpy sum m_i h_i up to float rounding. */
+
+/* Per particle: temperature, conductivity and volume, in the structure-of-arrays layout the neighbour
+ * loop reads on lanes (thermal = T, k, V blocks of `stride` floats). Moving water takes its volume from
+ * the summation density; static particles, and every particle when the flow is off, from rho0. */
+kernel void thermal_state(global const float4* pos, global const float* density, global const float2* enthalpy,
+                          global const uchar* phase, global const uchar* material,
+                          global const MaterialThermal* materials, const float rho0, const int flow,
+                          global float* thermal, const uint stride, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  const MaterialThermal m = materials[material[i]];
+  const float2 e = enthalpy[i];
+  const float h = e.x + e.y;
+  const float rho = (flow && !THAW_IS_STATIC(phase[i])) ? density[i] : rho0;
+  thermal[i] = thermal_temperature(h, m.latent, m.melt, m.c_solid, m.c_liquid);
+  thermal[stride + i] = m.conductivity;
+  thermal[2 * stride + i] = pos[i].w / rho;
+}
+
+/* Neighbour rows around cell c. Along periodic axes (-DTHAW_PERIODIC_X/Y/Z; the heat-only mode) the grid
+ * wraps and cells are visited one at a time, so that a wrapped x range needs no special case. */
+#if defined(THAW_PERIODIC_X) || defined(THAW_PERIODIC_Y) || defined(THAW_PERIODIC_Z)
+#define THAW_PERIODIC 1
+#endif
+
+#ifdef THAW_PERIODIC
+int wrap_axis(int v, int n, int periodic) { return periodic ? (v + n) % n : v; }
+#ifdef THAW_PERIODIC_X
+#define THAW_PX 1
+#else
+#define THAW_PX 0
+#endif
+#ifdef THAW_PERIODIC_Y
+#define THAW_PY 1
+#else
+#define THAW_PY 0
+#endif
+#ifdef THAW_PERIODIC_Z
+#define THAW_PZ 1
+#else
+#define THAW_PZ 0
+#endif
+#define FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je, ...)                  \
+  for (int dz_ = -1; dz_ <= 1; ++dz_) {                                     \
+    const int z_ = wrap_axis((c).z + dz_, (g).nz, THAW_PZ);                 \
+    if (z_ < 0 || z_ >= (g).nz) continue;                                   \
+    for (int dy_ = -1; dy_ <= 1; ++dy_) {                                   \
+      const int y_ = wrap_axis((c).y + dy_, (g).ny, THAW_PY);               \
+      if (y_ < 0 || y_ >= (g).ny) continue;                                 \
+      for (int dx_ = -1; dx_ <= 1; ++dx_) {                                 \
+        const int x_ = wrap_axis((c).x + dx_, (g).nx, THAW_PX);             \
+        if (x_ < 0 || x_ >= (g).nx) continue;                               \
+        const int cell_ = (z_ * (g).ny + y_) * (g).nx + x_;                 \
+        const uint jb = (cell_start)[cell_];                                \
+        const uint je = (cell_start)[cell_ + 1];                            \
+        __VA_ARGS__                                                         \
+      }                                                                     \
+    }                                                                       \
+  }
+#else
+#define FOR_EACH_HEAT_RANGE FOR_EACH_NEIGHBOUR_ROW
+#endif
+
+/* Minimum image along periodic axes: period = domain lengths (0 where not periodic). */
+#ifdef THAW_PERIODIC
+#define THAW_WRAP(d, L) ((L) > 0.0f ? (d) - (L) * rint((d) / (L)) : (d))
+#else
+#define THAW_WRAP(d, L) (d)
+#endif
+
+/* Compensated add: (hi, lo) + d with the rounding error of hi + d kept in lo (Knuth's two-sum), so heat
+ * increments far below one ulp of the enthalpy still add up. */
+float2 add_compensated(float2 e, float d) {
+  const float s = e.x + d;
+  const float bp = s - e.x;
+  const float err = (e.x - (s - bp)) + (d - bp);
+  const float lo = e.y + err;
+  const float hi = s + lo;
+  return (float2)(hi, lo - (hi - s));
+}
+
+/* Source categories of the energy budget, blocks of `stride` floats in `budget` [J this step]. */
+#define THAW_SRC_AMBIENT 0
+#define THAW_SRC_LAMPS 1
+#define THAW_SRC_DRYERS 2
+#define THAW_SRC_WALLS 3
+#define THAW_SRC_HELD 4
+#define THAW_SRC_COUNT 5
+
+/* One heat step of length dt_heat = time_scale * dt. exposed_r2: squared radius within which neighbours
+ * cover a face (Iwasaki 2010: (6 - n_i) / 6 of the voxel's area A = 6 dx^2 is exposed); face_area = dx^2.
+ * lamp_energy: each particle's absorbed photon energy this step [J], consumed (zeroed) here. */
+kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy, global uchar* phase,
+                 global uchar* material, global const MaterialThermal* materials, global const float* soa,
+                 global const float* thermal, const uint stride, global const uint* cell_start, const Grid g,
+                 const float H, const float eta2, const float4 period, const float exposed_r2,
+                 const float face_area, const float ambient_temperature, const float ambient_coefficient,
+                 global const DryerJet* dryers, const uint ndryers, global float* lamp_energy,
+                 const float dt_heat, global float* budget, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  const float4 pi = pos[i];
+  const int4 c = grid_cell(g, pi);
+  const float H2 = H * H;
+  const float inv_H = 1.0f / H;
+  global const float* X = soa;
+  global const float* Y = soa + stride;
+  global const float* Z = soa + 2 * stride;
+  global const float* TT = thermal;
+  global const float* KK = thermal + stride;
+  global const float* VV = thermal + 2 * stride;
+  const float Ti = TT[i];
+  const float ki = KK[i];
+  floatV acc = (floatV)(0.0f);
+  intV covered = (intV)(0);
+  FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je, {
+    for (uint j = jb; j < je; j += THAW_VW) {
+      const floatV dx = THAW_WRAP(pi.x - vloadV(0, X + j), period.x);
+      const floatV dy = THAW_WRAP(pi.y - vloadV(0, Y + j), period.y);
+      const floatV dz = THAW_WRAP(pi.z - vloadV(0, Z + j), period.z);
+      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      const intV lane = THAW_LANE_IDS < (int)(je - j);
+      const intV in = lane & (r2 < H2);
+      const floatV kj = vloadV(0, KK + j);
+      /* Harmonic mean; two insulators (k = 0) exchange nothing. */
+      const floatV kij = 2.0f * ki * kj / fmax(ki + kj, 1e-30f);
+      const floatV term = vloadV(0, VV + j) * kij * (Ti - vloadV(0, TT + j)) * grad_shape(sqrt(r2) * inv_H) *
+                          r2 / (r2 + eta2);
+      acc += select((floatV)(0.0f), term, in);
+      covered += select((intV)(0), (intV)(1), lane & (r2 < exposed_r2));
+    }
+  })
+  /* x . grad W = sigma / H^2 grad_shape(q) r^2 (sph_lanes.h). */
+  const float Vi = VV[i];
+  const float q_conduction = 2.0f * Vi * THAW_SIGMA(H) * inv_H * inv_H * lanes_sum(acc);
+  int neighbours = -1; /* the particle itself is in its own range */
+  for (int l = 0; l < THAW_VW; ++l) neighbours += ((int*)&covered)[l];
+
+  const uchar mi = material[i];
+  const MaterialThermal m = materials[mi];
+  /* Iwasaki 2010 sec. 4: dA = (6 - n_i) / 6 * 6 dx^2, clamped at 0. */
+  const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? face_area * (float)max(6 - neighbours, 0) : 0.0f;
+  float q_ambient = 0.0f, q_dryers = 0.0f, q_walls = 0.0f;
+  if (exposed > 0.0f) {
+    q_ambient = ambient_coefficient * (ambient_temperature - Ti) * exposed;
+    for (uint d = 0; d < ndryers; ++d) {
+      const float2 air = dryer_air(dryers[d], pi.x, pi.y, pi.z, ambient_temperature);
+      q_dryers += air.x * (air.y - Ti) * exposed;
+    }
+  }
+  if (m.flags & THAW_MAT_WALL_HEAT) q_walls = m.wall_coefficient * (m.wall_temperature - Ti);
+  const float e_lamps = lamp_energy[i];
+  lamp_energy[i] = 0.0f;
+
+  const float mass = pi.w * m.thermal_mass_scale;
+  const float e_ambient = q_ambient * dt_heat, e_dryers = q_dryers * dt_heat, e_walls = q_walls * dt_heat;
+  const float e_total = (q_conduction + q_ambient + q_dryers + q_walls) * dt_heat + e_lamps;
+  float2 e = add_compensated(enthalpy[i], e_total / mass);
+  float e_held = 0.0f;
+  if (m.flags & THAW_MAT_HELD) {
+    /* A thermostat: whatever heat the particle gained or lost, it is put back at its temperature. */
+    e_held = mass * ((m.held_enthalpy - e.x) - e.y);
+    e = (float2)(m.held_enthalpy, 0.0f);
+  }
+  enthalpy[i] = e;
+
+  /* Phase change once the latent heat is complete (Iwasaki 2010 sec. 4): the particle keeps its enthalpy
+   * and its physical mass; its SPH mass follows its new material's scale. */
+  const float h = e.x + e.y;
+  const uchar ph = phase[i];
+  int to = -1;
+  if ((m.flags & THAW_MAT_MELTS) && ph == THAW_PHASE_ICE && h >= m.latent) to = THAW_PHASE_WATER;
+  if ((m.flags & THAW_MAT_FREEZES) && ph == THAW_PHASE_WATER && h <= 0.0f) to = THAW_PHASE_ICE;
+  if (to >= 0) {
+    const MaterialThermal other = materials[m.partner];
+    phase[i] = (uchar)to;
+    material[i] = (uchar)m.partner;
+    pos[i] = (float4)(pi.xyz, mass / other.thermal_mass_scale);
+    vel[i] = (float4)(0.0f);
+  }
+
+  budget[THAW_SRC_AMBIENT * stride + i] = e_ambient;
+  budget[THAW_SRC_LAMPS * stride + i] = e_lamps;
+  budget[THAW_SRC_DRYERS * stride + i] = e_dryers;
+  budget[THAW_SRC_WALLS * stride + i] = e_walls;
+  budget[THAW_SRC_HELD * stride + i] = e_held;
+}
+
+/* Turns one lamp's photon hits into energy: lamp_energy[i] += hits[i] * photon_energy; hits cleared. */
+kernel void absorb_photons(global uint* hits, global float* lamp_energy, const float photon_energy, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  const uint k = hits[i];
+  if (k) {
+    lamp_energy[i] += (float)k * photon_energy;
+    hits[i] = 0;
+  }
+}
+
+/* Per-tile sums of the budget's categories (compensated, walked in order: deterministic), and the first
+ * particle whose enthalpy is not finite (~0 if none). out = THAW_SRC_COUNT floats per tile. */
+kernel void heat_budget(global const float* budget, global const float2* enthalpy, const uint stride,
+                        global float* out, global uint* bad, const uint n, const uint tile) {
+  const uint t = get_global_id(0);
+  const uint b = t * tile;
+  if (b >= n) return;
+  const uint e = min(n, b + tile);
+  uint first_bad = 0xffffffffu;
+  for (uint i = b; i < e; ++i) {
+    const float2 h = enthalpy[i];
+    if (!isfinite(h.x + h.y)) {
+      first_bad = i;
+      break;
+    }
+  }
+  bad[t] = first_bad;
+  for (int k = 0; k < THAW_SRC_COUNT; ++k) {
+    float sum = 0.0f, comp = 0.0f;
+    for (uint i = b; i < e; ++i) {
+      const float y = budget[k * stride + i] - comp;
+      const float s = sum + y;
+      comp = (s - sum) - y;
+      sum = s;
+    }
+    out[t * THAW_SRC_COUNT + k] = sum;
+  }
+}

@@ -1,0 +1,66 @@
+/* Enthalpy, temperature and liquid fraction of one material, shared verbatim by the OpenCL kernels and
+ * the host (scene sampling, metrics, tests), so that both sides convert with the same arithmetic.
+ *
+ * Each particle carries its specific enthalpy h [J/kg]; temperature and liquid fraction follow from it
+ * (DESIGN.md, Numerics). For a material pair that melts and freezes (ice <-> water) h = 0 is the solid
+ * at its melting point T_m:
+ *   h < 0        solid,  T = T_m + h / c_solid,              liquid fraction 0
+ *   0 <= h <= L  at the melting point, T = T_m,               liquid fraction h / L
+ *   h > L        liquid, T = T_m + (h - L) / c_liquid,        liquid fraction 1
+ * Both members of the pair use this same reference, so a particle keeps its h when it changes phase and
+ * the latent heat is conserved exactly. A material that does not change phase has L = 0 and
+ * c_solid = c_liquid = c, i.e. h = c (T - T_m). */
+#ifndef THAW_THERMAL_LAW_H
+#define THAW_THERMAL_LAW_H
+
+#ifdef __OPENCL_VERSION__
+#define THAW_TL_FN
+#else
+#include <cstdint>
+#define THAW_TL_FN inline
+namespace thaw::thermal {
+#endif
+
+/* Flags of MaterialThermal. */
+#define THAW_MAT_HELD 1u        /* held at held_enthalpy (a thermostat): the heat that takes is accounted */
+#define THAW_MAT_MELTS 2u       /* ice: becomes `partner` (a fluid) when its liquid fraction reaches 1 */
+#define THAW_MAT_FREEZES 4u     /* fluid: becomes `partner` (ice) when its liquid fraction reaches 0 */
+#define THAW_MAT_WALL_HEAT 8u   /* tank wall: exchanges heat with the outside (Domaradzki & Martyn sec. 7) */
+#define THAW_MAT_AIR_EXCHANGE 16u /* exposed surface exchanges heat with the ambient air and the dryers */
+
+/* One material's thermal data; every member is 4 bytes, so host and device layouts agree. */
+typedef struct {
+  float conductivity;       /* k [W/m/K] */
+  float c_solid, c_liquid;  /* specific heat below / above the melting point [J/kg/K] */
+  float latent;             /* L [J/kg]; 0 for materials that do not change phase */
+  float melt;               /* T_m [°C] */
+  float thermal_mass_scale; /* physical mass / the particle's SPH mass (solids, ice: rho / rho0) */
+  float held_enthalpy;      /* THAW_MAT_HELD: the enthalpy the particle is held at [J/kg] */
+  float wall_coefficient;   /* THAW_MAT_WALL_HEAT: U * A / layers per particle [W/K] */
+  float wall_temperature;   /* THAW_MAT_WALL_HEAT: the outside temperature [°C] */
+  int partner;              /* material a phase change turns the particle into; -1 none */
+  unsigned int flags;       /* THAW_MAT_* */
+  float pad_;
+} MaterialThermal;
+
+THAW_TL_FN float thermal_temperature(float h, float latent, float melt, float c_solid, float c_liquid) {
+  return h < 0.0f ? melt + h / c_solid : (h > latent ? melt + (h - latent) / c_liquid : melt);
+}
+
+/* The enthalpy of the solid (liquid = 0) or the liquid (liquid = 1) at T; at T_m the solid has h = 0
+ * and the liquid h = L. */
+THAW_TL_FN float thermal_enthalpy(float T, int liquid, float latent, float melt, float c_solid, float c_liquid) {
+  return liquid ? latent + c_liquid * (T - melt) : c_solid * (T - melt);
+}
+
+/* For materials that change phase; 0 or 1 otherwise. */
+THAW_TL_FN float thermal_liquid_fraction(float h, float latent) {
+  return latent > 0.0f ? (h <= 0.0f ? 0.0f : (h >= latent ? 1.0f : h / latent)) : (h > 0.0f ? 1.0f : 0.0f);
+}
+
+#ifndef __OPENCL_VERSION__
+static_assert(sizeof(MaterialThermal) == 48, "MaterialThermal must match its OpenCL layout");
+}  // namespace thaw::thermal
+#endif
+#undef THAW_TL_FN
+#endif

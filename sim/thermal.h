@@ -1,0 +1,32 @@
+#pragma once
+// The host side of the heat model: each material's thermal law for the device (sim/kernels/thermal_law.h),
+// and conversions between temperature and the enthalpy a particle carries.
+#include <vector>
+
+#include "sim/kernels/thermal_law.h"
+#include "sim/scene.h"
+
+namespace thaw {
+
+using thermal::MaterialThermal;
+
+// One entry per Scene::materials, in order; rest_density is the fluid's rho0, which sets the SPH mass
+// of static particles (solids and ice carry rho0 V, their physical mass is rho V).
+std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density, int wall_layers);
+
+// Specific enthalpy [J/kg] of a particle of `material` at temperature T [°C] (ice below or at its melting
+// point is solid, everything else is on its liquid side).
+double enthalpy_at(const Scene& scene, int material, double temperature);
+
+// Temperature [°C] and liquid fraction from a particle's enthalpy.
+double temperature_at(const MaterialThermal& m, double enthalpy);
+double liquid_fraction_at(const MaterialThermal& m, double enthalpy);
+
+// Thermal diffusivity k / (rho c) of the most diffusive material [m^2/s] on either side of its melting
+// point, over the materials the scene's particles can have: it sets the diffusion time-step limit.
+double max_diffusivity(const Scene& scene);
+
+// Kelvin offset of the Celsius scale, for radiation.
+inline constexpr double kKelvin = 273.15;
+
+}  // namespace thaw
