@@ -10,7 +10,7 @@ std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double r
   const double dx = scene.spacing;
   for (const Material& m : scene.materials) {
     MaterialThermal t{};
-    t.conductivity = static_cast<float>(m.conductivity);
+    t.k_solid = t.k_liquid = static_cast<float>(m.conductivity);
     t.c_solid = t.c_liquid = static_cast<float>(m.specific_heat);
     t.partner = m.partner;
     if (m.partner >= 0) {
@@ -18,6 +18,8 @@ std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double r
       const bool ice = m.kind == "ice";
       t.c_solid = static_cast<float>(ice ? m.specific_heat : other.specific_heat);
       t.c_liquid = static_cast<float>(ice ? other.specific_heat : m.specific_heat);
+      t.k_solid = static_cast<float>(ice ? m.conductivity : other.conductivity);
+      t.k_liquid = static_cast<float>(ice ? other.conductivity : m.conductivity);
       t.latent = static_cast<float>(m.latent_heat);
       t.melt = static_cast<float>(m.melting_point);
       t.flags |= ice ? THAW_MAT_MELTS : THAW_MAT_FREEZES;

@@ -24,7 +24,13 @@ kernel void thermal_state(global const float4* pos, global const float* density,
   const float h = e.x + e.y;
   const float rho = (flow && !THAW_IS_STATIC(phase[i])) ? density[i] : rho0;
   thermal[i] = thermal_temperature(h, m.latent, m.melt, m.c_solid, m.c_liquid);
-  thermal[stride + i] = m.conductivity;
+  /* A held particle is isothermal, as if it conducted without limit: the pair's harmonic mean then
+   * tends to 2 k_j, the conductance of the neighbour's half of the path alone. With its own k instead,
+   * a held wall took the resistance of a particle-wide layer (the front lagged about 0.4 spacings in
+   * `thaw validate stefan`). 1e6 W/m/K is far above any real material and keeps the float sums finite. */
+  thermal[stride + i] = (m.flags & THAW_MAT_HELD)
+                            ? 1.0e6f
+                            : thermal_conductivity(h, m.latent, m.k_solid, m.k_liquid, phase[i] == THAW_PHASE_ICE);
   thermal[2 * stride + i] = pos[i].w / rho;
 }
 

@@ -30,7 +30,7 @@ namespace thaw::thermal {
 
 /* One material's thermal data; every member is 4 bytes, so host and device layouts agree. */
 typedef struct {
-  float conductivity;       /* k [W/m/K] */
+  float k_solid, k_liquid;  /* conductivity below / above the melting point [W/m/K] */
   float c_solid, c_liquid;  /* specific heat below / above the melting point [J/kg/K] */
   float latent;             /* L [J/kg]; 0 for materials that do not change phase */
   float melt;               /* T_m [°C] */
@@ -40,7 +40,6 @@ typedef struct {
   float wall_temperature;   /* THAW_MAT_WALL_HEAT: the outside temperature [°C] */
   int partner;              /* material a phase change turns the particle into; -1 none */
   unsigned int flags;       /* THAW_MAT_* */
-  float pad_;
 } MaterialThermal;
 
 THAW_TL_FN float thermal_temperature(float h, float latent, float melt, float c_solid, float c_liquid) {
@@ -51,6 +50,22 @@ THAW_TL_FN float thermal_temperature(float h, float latent, float melt, float c_
  * and the liquid h = L. */
 THAW_TL_FN float thermal_enthalpy(float T, int liquid, float latent, float melt, float c_solid, float c_liquid) {
   return liquid ? latent + c_liquid * (T - melt) : c_solid * (T - melt);
+}
+
+/* Conductivity of a particle. At the melting point the particle holds the front: it is part converted
+ * (the phase forming: liquid while an ice particle melts, solid while a water particle freezes) and
+ * pinned at T_m, so the temperature drop to a converted neighbour happens over the distance to the
+ * front, dx/2 + phi dx for a converted fraction phi, not over dx. The harmonic-mean pair conductivity
+ * 2 k_n k / (k_n + k) gives exactly that flux in 1-D when k = k_n / (2 phi) (k_n: the forming phase's),
+ * a sub-particle front position recovered from the enthalpy. Without it the front lags by about one
+ * spacing (measured with `thaw validate stefan`: 17 % at 10 particles across the front when freezing).
+ * phi is kept above 1/20, so k stays finite. */
+THAW_TL_FN float thermal_conductivity(float h, float latent, float k_solid, float k_liquid, int melting) {
+  if (h <= 0.0f) return k_solid;
+  if (h >= latent) return k_liquid;
+  const float liquid = h / latent;
+  const float converted = melting ? liquid : 1.0f - liquid;
+  return (melting ? k_liquid : k_solid) / (2.0f * (converted > 0.05f ? converted : 0.05f));
 }
 
 /* For materials that change phase; 0 or 1 otherwise. */
