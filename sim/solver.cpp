@@ -723,6 +723,17 @@ void Solver::set_lamp(std::size_t index, const Lamp& l) {
   scene_.lamps[index] = checked;
 }
 
+Solver::ThermalInputs Solver::thermal_inputs() const {
+  ThermalInputs t;
+  if (!heat_ || n_ == 0) return t;
+  std::vector<float> all(std::size_t(stride_) * 3);
+  cl_.queue().enqueueReadBuffer(thermal_, CL_TRUE, 0, all.size() * 4, all.data());
+  t.temperature.assign(all.begin(), all.begin() + long(n_));
+  t.conductivity.assign(all.begin() + long(stride_), all.begin() + long(stride_ + n_));
+  t.volume.assign(all.begin() + 2 * long(stride_), all.begin() + long(2 * stride_ + n_));
+  return t;
+}
+
 double Solver::total_enthalpy() const {
   if (!heat_ || n_ == 0) return 0.0;
   const HostParticles p = particles();

@@ -116,6 +116,12 @@ class Solver {
   std::vector<float> densities() const;
   std::vector<Float4> pressure_state() const;  // per particle (rho, p/rho^2, is_boundary, p)
   std::vector<float> temperatures() const;     // per particle [°C], from the last heat stage's state
+  // The heat stage's inputs as its neighbour loop reads them (for reference loops and tests): T [°C],
+  // k [W/m/K] and V [m^3] per particle, from the last compute_heat(); empty without heat.
+  struct ThermalInputs {
+    std::vector<float> temperature, conductivity, volume;
+  };
+  ThermalInputs thermal_inputs() const;
 
  private:
   void compute_boundary_psi();

@@ -64,11 +64,23 @@ double liquid_fraction_at(const MaterialThermal& m, double h) {
 }
 
 double max_diffusivity(const Scene& scene) {
+  // Materials some particle has or can turn into.
+  std::vector<bool> used(scene.materials.size(), false);
+  auto use = [&](int m) {
+    if (m < 0) return;
+    used[static_cast<std::size_t>(m)] = true;
+    const int partner = scene.materials[static_cast<std::size_t>(m)].partner;
+    if (partner >= 0) used[static_cast<std::size_t>(partner)] = true;
+  };
+  for (const auto& f : scene.fluids) use(f.material);
+  for (const auto& c : scene.ice) use(c.material);
+  for (const auto& s : scene.solids) use(s.material);
+  if (!scene.walls.empty()) use(scene.wall_material);
   double alpha = 0;
-  for (const Material& m : scene.materials) {
-    alpha = std::max(alpha, m.conductivity / (m.density * m.specific_heat));
-    // Ice that melts takes the fluid's c and rho0 with its own k only for one step; the fluid's own
-    // entry covers it. Frozen fluid likewise has the ice's entry.
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    // Held solids are reset every step: their own diffusion needs no limit.
+    if (used[i] && !m.held) alpha = std::max(alpha, m.conductivity / (m.density * m.specific_heat));
   }
   return alpha;
 }

@@ -22,8 +22,8 @@ double enthalpy_at(const Scene& scene, int material, double temperature);
 double temperature_at(const MaterialThermal& m, double enthalpy);
 double liquid_fraction_at(const MaterialThermal& m, double enthalpy);
 
-// Thermal diffusivity k / (rho c) of the most diffusive material [m^2/s] on either side of its melting
-// point, over the materials the scene's particles can have: it sets the diffusion time-step limit.
+// Thermal diffusivity k / (rho c) of the most diffusive material [m^2/s] that some particle has or can
+// turn into (held solids excepted): it sets the diffusion time-step limit.
 double max_diffusivity(const Scene& scene);
 
 // Kelvin offset of the Celsius scale, for radiation.

@@ -14,8 +14,8 @@ Json tank_scene_json(const TankScene& t) {
       {"gravity", {0, 0, -t.gravity}},
       {"spacing", t.spacing},
       {"solver", t.solver},
-      // Water mechanics only: these cases measure pressure and flow, and heat would only add cost.
-      {"heat", {{"enabled", false}}},
+      // The validation cases measure pressure and flow; heat would only add cost to them.
+      {"heat", {{"enabled", t.heat}}},
       {"materials",
        {{"water",
          {{"kind", "fluid"},
@@ -24,7 +24,7 @@ Json tank_scene_json(const TankScene& t) {
           {"conductivity", 0.56},
           {"specific_heat", 4217.0}}},
         {"wall", {{"kind", "solid"}, {"density", 2500.0}, {"conductivity", 1.0}, {"specific_heat", 840.0}}}}},
-      {"fluids", {{{"material", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", vec(t.water)}}}}}},
+      {"fluids", {{{"material", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", vec(t.water)}}}, {"temperature", 30.0}}}},
   };
 }
 

@@ -18,6 +18,7 @@ struct TankScene {
   double density = 1000.0;
   double viscosity = 1.0e-3;
   Json solver = Json::object();  // the "solver" section, defaults where absent
+  bool heat = false;             // thermal stages: water at 30 °C in 20 °C air (benchmarks); off for mechanics
 };
 
 Json tank_scene_json(const TankScene& t);

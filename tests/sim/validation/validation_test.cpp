@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "sim/error.h"
 #include "sim/solver.h"
 #include "sim/validation/case.h"
 #include "sim/validation/hydrostatic_profile.h"
@@ -80,6 +81,36 @@ TEST_F(Validation, DamBreakFrontFollowsMartinMoyce) {
     EXPECT_LT(m.error, 0.2) << key;
   }
   EXPECT_LE(r.metrics.back().second.error, r.metrics.back().second.gate) << r.metrics.back().first;
+}
+
+TEST_F(Validation, ConductionPassesOnOrderedAndJitteredParticles) {
+  for (const char* jitter : {"jitter=0", "jitter=0.1"}) {
+    const CaseResult r = run_validation(cl(), "conduction", 3, {jitter});
+    print(r);
+    EXPECT_TRUE(r.passed()) << jitter;
+    ASSERT_EQ(r.metrics.size(), 3u);
+    EXPECT_EQ(r.metrics[0].second.gate, std::string(jitter) == "jitter=0" ? 0.01 : 0.03);
+  }
+}
+
+// Melting and freezing at 20 particles across the front, one-phase (the slab at the melting point) so
+// that CI stays short; the default two-phase case is in docs/VALIDATION-RESULTS.md.
+TEST_F(Validation, StefanMeltingAndFreezingPass) {
+  for (const std::vector<std::string>& set : {std::vector<std::string>{"wall_temperature=30", "initial_temperature=0"},
+                                              std::vector<std::string>{"wall_temperature=-20", "initial_temperature=0"}}) {
+    const CaseResult r = run_validation(cl(), "stefan", 20, set);
+    print(r);
+    EXPECT_TRUE(r.passed()) << set[0];
+    ASSERT_EQ(r.metrics.size(), 2u);
+    EXPECT_EQ(r.metrics[0].first, "front");
+    // The reference follows the parameters: a hotter wall melts faster than the table's +10 °C.
+    if (set[0] == "wall_temperature=30") EXPECT_GT(r.metrics[0].second.reference, 4.395e-3 * 1.2);
+  }
+}
+
+TEST_F(Validation, StefanRefusesParametersThatNeitherMeltNorFreeze) {
+  EXPECT_THROW(run_validation(cl(), "stefan", 5, {"wall_temperature=10", "initial_temperature=5"}), SceneError);
+  EXPECT_THROW(run_validation(cl(), "stefan", 5, {"wall_temperature=0"}), SceneError);
 }
 
 TEST(ValidateCli, JsonReportHasTheDocumentedShape) {
