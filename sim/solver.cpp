@@ -93,7 +93,7 @@ SolverConstants derive_constants(const Scene& scene) {
   k.rest_density = static_cast<float>(fluid ? fluid->density : 1000.0);
   k.kinematic_viscosity = static_cast<float>(fluid ? fluid->viscosity / fluid->density : 0.0);
 
-  // Reference speed: free fall from the highest fluid to the bottom of the domain, or the fastest
+  // Reference speed: free fall from the highest fluid or ice to the bottom of the domain, or the fastest
   // initial velocity, whichever is larger.
   double v_ref = s.reference_speed;
   if (v_ref <= 0) {
@@ -101,9 +101,11 @@ SolverConstants derive_constants(const Scene& scene) {
     if (g > 0) {
       const Eigen::Vector3d up = -scene.gravity / g;
       double top = -std::numeric_limits<double>::infinity();
+      // Ice turns into water where it stands, so its top counts too.
       for (const auto& f : scene.fluids) top = std::max(top, f.box.max_along(up));
+      for (const auto& c : scene.ice) top = std::max(top, c.box.max_along(up));
       const double bottom = -scene.domain.max_along(-up);
-      if (!scene.fluids.empty()) v_ref = std::sqrt(2.0 * g * std::max(0.0, top - bottom));
+      if (!scene.fluids.empty() || !scene.ice.empty()) v_ref = std::sqrt(2.0 * g * std::max(0.0, top - bottom));
     }
     for (const auto& f : scene.fluids) v_ref = std::max(v_ref, f.velocity.norm());
     v_ref = std::max(v_ref, 0.1);  // a still fluid in zero gravity still needs a finite stiffness

@@ -181,6 +181,45 @@ TEST(ThawCli, ShortRunWritesMetricsAndExports) {
   EXPECT_EQ(pvd, 1);
 }
 
+// A melting scene through the command line: heat metrics, temperatures in the exports, resuming
+// from a state file, and a runtime-style override of a heat source from --set.
+TEST(ThawCli, HeatRunReportsTheEnergyBudgetAndExportsTemperature) {
+  TempDir dir("cli-heat");
+  const auto r = run_thaw(
+      "run ice-on-plate --steps 30 --set spacing=0.006 --set solver.output_interval=0.005 "
+      "--metrics m.jsonl --export out --every 30 --state-out half.state --no-progress",
+      dir);
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  EXPECT_NE(r.out.find("energy closure"), std::string::npos) << r.out;
+  std::ifstream in(dir / "m.jsonl");
+  Json last;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) last = Json::parse(line);
+  for (const char* key : {"mass", "temperature", "heat"}) ASSERT_TRUE(last.contains(key)) << last.dump();
+  const Json& heat = last["heat"];
+  EXPECT_GT(heat["in"]["held"].get<double>(), 0.0) << "the plate is held at 40 °C";
+  EXPECT_LT(std::abs(heat["closure_relative"].get<double>()), 1e-6) << heat.dump();
+  EXPECT_LE(last["temperature"]["max"].get<double>(), 40.0);
+
+  // The PLY header and the VTU name the temperature.
+  std::ifstream ply(dir.path() / "out" / "frame_000001.ply", std::ios::binary);
+  std::string header((std::istreambuf_iterator<char>(ply)), {});
+  EXPECT_NE(header.find("property float temperature"), std::string::npos);
+  std::ifstream vtu(dir.path() / "out" / "frame_000001.vtu", std::ios::binary);
+  std::string xml((std::istreambuf_iterator<char>(vtu)), {});
+  EXPECT_NE(xml.find("Name=\"temperature\""), std::string::npos);
+
+  // Resuming carries the enthalpy and the energy account: 30 + 30 steps equal 60 straight.
+  const auto straight = run_thaw(
+      "run ice-on-plate --steps 60 --set spacing=0.006 --set solver.output_interval=0.005 --state-out full.state "
+      "--no-progress --quiet",
+      dir);
+  ASSERT_TRUE(straight.exited && straight.exit_code == 0) << describe(straight);
+  const auto resumed = run_thaw("run --state-in half.state --steps 30 --state-out resumed.state --no-progress --quiet", dir);
+  ASSERT_TRUE(resumed.exited && resumed.exit_code == 0) << describe(resumed);
+  EXPECT_TRUE(testing::read_file_bytes(dir / "full.state") == testing::read_file_bytes(dir / "resumed.state"));
+}
+
 TEST(ThawCli, SceneDocMatchesTheCommittedReference) {
   TempDir dir("cli-scene-doc");
   const auto r = run_thaw("scene-doc", dir);
