@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <thread>
 
 #include "bench/reference_density.h"
+#include "bench/reference_heat.h"
 #include "sim/solver.h"
+#include "sim/thermal.h"
 #include "sim/validation/tank_scene.h"
 
 namespace thaw {
@@ -80,6 +83,83 @@ double max_diff_of_range(const std::vector<float>& ref, const std::vector<float>
   return top > 0 ? d / top : d;
 }
 
+struct HeatComparison {
+  double device_us = 0, lanes_us = 0, scalar_us = 0;  // per fluid particle
+  double lanes_diff = 0, scalar_diff = 0;             // max |Q_ref - Q_dev| / max |Q_dev|
+  double max_q = 0;                                   // max |Q_dev| [W]
+};
+
+// The heat stage against the reference conduction loops, on the sorted state build_grid() and
+// compute_density() left. The device does not expose Q: one compute_heat(dt) adds Q dt_heat / mass to
+// each particle's enthalpy, so Q_dev = (h_after - h_before) mass / dt_heat, with the inputs
+// (T, k, V) of that same call (thermal_state runs first in compute_heat). The scene has no dryers,
+// lamps, held or wall-heated materials, so Q = conduction + ambient air exchange.
+HeatComparison compare_heat(ClRuntime& cl, Solver& solver, const Scene& scene, const ReferenceParticles& rp,
+                            const ReferenceGrid& g, double fluid, int reps,
+                            const std::function<void()>& pause) {
+  HeatComparison c;
+  const auto& k = solver.constants();
+  const auto table = material_thermal_table(scene, k.rest_density, 1);  // wall layers: no wall heat here
+  const float dt_heat = static_cast<float>(scene.heat.time_scale * solver.dt());
+  const auto before = solver.particles();
+  solver.compute_heat(solver.dt());
+  cl.queue().finish();
+  const auto after = solver.particles();
+  const auto in = solver.thermal_inputs();
+  std::vector<std::uint8_t> air(before.size());
+  std::vector<float> q_dev(before.size());
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    const auto& m = table[before.material[i]];
+    air[i] = (m.flags & THAW_MAT_AIR_EXCHANGE) ? 1 : 0;
+    const double dh = (double(after.enthalpy[i][0]) - before.enthalpy[i][0]) +
+                      (double(after.enthalpy[i][1]) - before.enthalpy[i][1]);
+    q_dev[i] = static_cast<float>(dh * (before.position[i][3] * m.thermal_mass_scale) / dt_heat);
+  }
+  const ReferenceThermal rt(in.temperature, in.conductivity, in.volume, air);
+  ReferenceHeatParams prm;
+  prm.H = k.support;
+  prm.eta2 = 0.01f * k.smoothing * k.smoothing;
+  const float dx = static_cast<float>(scene.spacing);
+  prm.exposed_r2 = 1.44f * dx * dx;
+  prm.wendland = scene.solver.kernel == "wendland_c2";
+  prm.face_area = dx * dx;
+  prm.ambient_temperature = static_cast<float>(scene.heat.ambient_temperature);
+  prm.ambient_coefficient = static_cast<float>(scene.heat.ambient_coefficient);
+
+  ReferenceHeat lanes, scalar;
+  reference_conduction_lanes(rp, g, rt, prm, lanes);  // warm caches and threads
+  reference_conduction(rp, g, rt, prm, scalar);
+  // Timed with dt = 0: the kernel does all its work but adds no heat.
+  double dev_best = std::numeric_limits<double>::infinity(), lanes_best = dev_best, scalar_best = dev_best;
+  for (int r = 0; r < reps; ++r) {
+    pause();
+    auto t = Clock::now();
+    solver.compute_heat(0.0);
+    cl.queue().finish();
+    dev_best = std::min(dev_best, seconds_since(t));
+    pause();
+    t = Clock::now();
+    reference_conduction_lanes(rp, g, rt, prm, lanes);
+    lanes_best = std::min(lanes_best, seconds_since(t));
+    pause();
+    t = Clock::now();
+    reference_conduction(rp, g, rt, prm, scalar);
+    scalar_best = std::min(scalar_best, seconds_since(t));
+  }
+  c.device_us = 1e6 * dev_best / fluid;
+  c.lanes_us = 1e6 * lanes_best / fluid;
+  c.scalar_us = 1e6 * scalar_best / fluid;
+  std::vector<float> q_lanes(q_dev.size()), q_scalar(q_dev.size());
+  for (std::size_t i = 0; i < q_dev.size(); ++i) {
+    q_lanes[i] = lanes.q_conduction[i] + lanes.q_ambient[i];
+    q_scalar[i] = scalar.q_conduction[i] + scalar.q_ambient[i];
+    c.max_q = std::max(c.max_q, double(std::abs(q_dev[i])));
+  }
+  c.lanes_diff = max_diff_of_range(q_lanes, q_dev);
+  c.scalar_diff = max_diff_of_range(q_scalar, q_dev);
+  return c;
+}
+
 }  // namespace
 
 Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
@@ -90,8 +170,9 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
   out["unit"] = "wall microseconds per fluid particle-step";
   Json rows = Json::array();
   if (print)
-    std::printf("%-9s %-9s %8s %8s %8s %8s %8s %8s %8s | %8s %8s %8s %6s\n", "fluid", "total", "grid", "density",
-                "forces", "dt", "heat", "integr", "step", "dens iso", "ref lane", "ref scal", "ratio");
+    std::printf("%-9s %-9s %8s %8s %8s %8s %8s %8s %8s | %8s %8s %8s %6s\n", "fluid", "total", "grid",
+                "density", "forces", "dt", "heat", "integr", "step", "dens iso", "ref lane", "ref scal",
+                "ratio");
   for (std::size_t size : o.sizes) {
     const Scene scene = throughput_scene(size);
     Solver solver(cl, scene, initial_state(scene));
@@ -135,7 +216,7 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
     double dev_best = std::numeric_limits<double>::infinity(), lanes_best = dev_best, scalar_best = dev_best;
     // Both runtimes keep their worker threads spinning a while after a parallel section; a pause
     // before each timed run lets the other's threads go to sleep first.
-    const auto pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(20)); };
+    const std::function<void()> pause = [] { std::this_thread::sleep_for(std::chrono::milliseconds(20)); };
     for (int r = 0; r < reps; ++r) {
       pause();
       auto t = Clock::now();
@@ -161,6 +242,10 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
       scalar_p[i] = scalar.state[i][3];
     }
 
+    // The heat stage against its reference loops, on the same sorted data (and the same alternation).
+    const HeatComparison heat = compare_heat(cl, solver, scene, rp, g, fluid, reps, pause);
+    const double heat_ref_us = std::min(heat.lanes_us, heat.scalar_us);
+
     const auto& t = solver.timers();
     Json row;
     row["fluid_particles"] = std::size_t(fluid);
@@ -179,6 +264,15 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
     row["reference_scalar_max_rel_diff_rho"] = max_rel_diff(scalar.rho, device_rho);
     row["reference_lanes_max_diff_p_of_max_p"] = max_diff_of_range(lanes_p, dev_p);
     row["reference_scalar_max_diff_p_of_max_p"] = max_diff_of_range(scalar_p, dev_p);
+    row["heat_isolated_us"] = heat.device_us;
+    row["reference_heat_lanes_us"] = heat.lanes_us;
+    row["reference_heat_scalar_us"] = heat.scalar_us;
+    row["reference_heat_us"] = heat_ref_us;
+    row["heat_ratio"] = heat.device_us / heat_ref_us;
+    row["reference_heat_lanes_max_rel_diff_q"] = heat.lanes_diff;
+    row["reference_heat_scalar_max_rel_diff_q"] = heat.scalar_diff;
+    row["reference_heat_max_rel_diff_q"] = std::max(heat.lanes_diff, heat.scalar_diff);
+    row["heat_max_q_w"] = heat.max_q;
     const WalkCounts w = walk_counts(rp, g, k.support);
     row["grid_reach"] = gi.reach;
     row["candidates_per_particle"] = w.candidates;
@@ -189,14 +283,18 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
       std::printf("%-9zu %-9zu %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f | %8.4f %8.4f %8.4f %6.2f\n",
                   std::size_t(fluid), p.size(), double(st["grid"]), double(st["density"]),
                   double(st["forces"]), double(st["time_step"]), double(st["heat"]), double(st["integrate"]),
-                  double(st["step"]),
-                  dev_us, lanes_us, scalar_us, dev_us / ref_us);
+                  double(st["step"]), dev_us, lanes_us, scalar_us, dev_us / ref_us);
       std::printf(
           "          check vs device: rho max rel diff %.2e (lanes) %.2e (scalar); p max diff / max p "
           "%.2e / %.2e; per fluid particle %.1f candidates (%.1f lane slots), %.1f neighbours\n",
           double(row["reference_lanes_max_rel_diff_rho"]), double(row["reference_scalar_max_rel_diff_rho"]),
           double(row["reference_lanes_max_diff_p_of_max_p"]),
           double(row["reference_scalar_max_diff_p_of_max_p"]), w.candidates, w.lane_slots, w.neighbours);
+      std::printf(
+          "          heat: iso %.4f, ref lane %.4f, ref scal %.4f, ratio %.2f; check vs device: Q max diff / "
+          "max |Q| %.2e (lanes) %.2e (scalar), max |Q| %.3g W\n",
+          heat.device_us, heat.lanes_us, heat.scalar_us, heat.device_us / heat_ref_us, heat.lanes_diff,
+          heat.scalar_diff, heat.max_q);
     }
     std::fflush(stdout);
   }
@@ -207,7 +305,12 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
         " hand-written C++/OpenMP loops over the same sorted data, %d threads: ref lane (8 candidates at a "
         "time,\n"
         " as the device) and ref scal (one at a time); ratio: dens iso / the faster reference; fastest of %d "
-        "runs each)\n",
+        "runs each.\n"
+        " heat: the same for the device heat stage alone (compute_heat with dt = 0: thermal state, "
+        "conduction,\n"
+        " sources, budget) against the reference conduction loop with the air exchange; its Q check takes "
+        "the\n"
+        " device's Q from the enthalpy change of one compute_heat(dt))\n",
         omp_get_max_threads(), std::max(5, o.steps));
   out["sizes"] = rows;
   return out;

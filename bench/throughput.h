@@ -1,6 +1,6 @@
 #pragma once
 // Throughput: wall microseconds per particle-step for each stage of the water step, at several sizes,
-// with a hand-written C++/OpenMP density loop over the same sorted data as the reference.
+// with hand-written C++/OpenMP density and heat-conduction loops over the same sorted data as the references.
 #include <vector>
 
 #include "sim/cl_runtime.h"

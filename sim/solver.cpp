@@ -231,7 +231,7 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   const auto integrate = cl.build(with_prelude({"integrate.cl", "step_limits.cl"}), opts.str());
   heat_ = scene.heat.enabled;
   if (heat_) {
-    std::string heat_opts = opts.str();
+    std::string heat_opts = opts.str() + " -DTHAW_EXPOSED_AREA=" + scene.heat.exposed_area;
     for (int a = 0; a < 3; ++a)
       if (scene.solver.periodic[static_cast<std::size_t>(a)]) heat_opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
     const auto heat = cl.build(with_prelude({"thermal_law.h", "dryer_model.h", "heat.cl"}), heat_opts);

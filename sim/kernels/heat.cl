@@ -96,6 +96,18 @@ float2 add_compensated(float2 e, float d) {
   return (float2)(hi, lo - (hi - s));
 }
 
+/* Exposed-area models (heat.exposed_area), chosen at build time with -DTHAW_EXPOSED_AREA=name: the
+ * area [m^2] of a particle's surface in contact with air, from the particles that cover it. A surface
+ * model that estimates each particle's area (Orthmann et al. 2013) adds its function here. */
+float exposed_area_iwasaki2010(int neighbours, float face_area) {
+  /* Iwasaki et al. 2010 sec. 4: dA = (6 - n_i) / 6 of the voxel's A = 6 dx^2, clamped at 0. */
+  return face_area * (float)max(6 - neighbours, 0);
+}
+#ifndef THAW_EXPOSED_AREA
+#define THAW_EXPOSED_AREA iwasaki2010
+#endif
+#define THAW_EXPOSED_FN THAW_CAT(exposed_area_, THAW_EXPOSED_AREA)
+
 /* Source categories of the energy budget, blocks of `stride` floats in `budget` [J this step]. */
 #define THAW_SRC_AMBIENT 0
 #define THAW_SRC_LAMPS 1
@@ -155,8 +167,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
 
   const uchar mi = material[i];
   const MaterialThermal m = materials[mi];
-  /* Iwasaki 2010 sec. 4: dA = (6 - n_i) / 6 * 6 dx^2, clamped at 0. */
-  const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? face_area * (float)max(6 - neighbours, 0) : 0.0f;
+  const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? THAW_EXPOSED_FN(neighbours, face_area) : 0.0f;
   float q_ambient = 0.0f, q_dryers = 0.0f, q_walls = 0.0f;
   if (exposed > 0.0f) {
     q_ambient = ambient_coefficient * (ambient_temperature - Ti) * exposed;
