@@ -18,8 +18,11 @@
 //   flags          u32      0 in version 1
 //   header sum     u64      FNV-1a-64 of every byte above
 //   scene JSON     bytes
-//   sections       each: name length u32, name, flags u32 (bit 0: required), element size u32,
-//                  count u64, count * element size bytes
+//   sections       each: name length u32, name, flags u32 (bit 0: required; bit 1: global, i.e. a
+//                  record of the run whose count is its own, not the particle count), element size u32,
+//                  count u64, count * element size bytes. Per particle: position, velocity, density,
+//                  phase, material, id, enthalpy (two floats: hi, lo). Global: energy_budget (doubles,
+//                  only in runs with heat).
 //   checksum       u64      FNV-1a-64 of every byte before it
 // Arrays are named sections so later versions can add per-particle fields (temperature, enthalpy,
 // body id) without breaking readers: a reader skips unknown optional sections and refuses unknown
