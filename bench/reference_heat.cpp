@@ -6,17 +6,17 @@
 #include <cmath>
 #include <cstring>
 
+#include "bench/reference_lanes.h"
 #include "sim/kernels/sph_kernel.h"
 
 namespace thaw {
 namespace {
 
+using namespace reference;
+
 constexpr int kLanes = 8;
 constexpr float kPi = 3.14159265358979f;
 
-int cell_of(float x, float origin, float inv_cell, int n) {
-  return std::clamp(static_cast<int>(std::floor((x - origin) * inv_cell)), 0, n - 1);
-}
 
 void resize(ReferenceHeat& out, std::size_t n) {
   out.q_conduction.resize(n);
@@ -78,17 +78,6 @@ void scalar_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refe
   }
 }
 
-// Eight lanes as GCC vector types (the same operations as the device's float8 code; sqrt is AVX's).
-typedef float v8f __attribute__((vector_size(32)));
-typedef int v8i __attribute__((vector_size(32)));
-
-inline v8f load8(const float* p) {
-  v8f v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline v8f sqrt8(v8f x) { return reinterpret_cast<v8f>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x))); }
-inline v8f splat8(float x) { return v8f{} + x; }
 
 // grad_factor / (sigma / H^2) as a function of q = r / H (sim/kernels/sph_lanes.h).
 template <bool kWendland>

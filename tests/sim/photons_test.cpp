@@ -307,7 +307,9 @@ TEST_F(PhotonTracerTest, SlabUnderALampAbsorbsNearlyAllInItsTopLayerOnly) {
   EXPECT_EQ(sum(hits), tally.absorbed);
   EXPECT_GE(tally.absorbed, photons - 20);
   for (std::size_t i = 0; i < hits.size(); ++i)
-    if (hits[i] > 0) ASSERT_EQ(s.layer(i), 3) << "particle " << i << " below the top layer was hit";
+    if (hits[i] > 0) {
+      ASSERT_EQ(s.layer(i), 3) << "particle " << i << " below the top layer was hit";
+    }
 
   // Facing away, every photon leaves through the top of the grid.
   zero_hits(cl(), d);
@@ -329,7 +331,9 @@ TEST_F(PhotonTracerTest, LampBelowTheGridReachesOnlyTheBottomLayer) {
   // Photons pass under the grid's edge only if cos(theta) < 0.01 / 1.5: probability 4e-5.
   EXPECT_GE(tally.absorbed, 19980u);
   for (std::size_t i = 0; i < hits.size(); ++i)
-    if (hits[i] > 0) ASSERT_EQ(s.layer(i), 0) << "particle " << i << " above the bottom layer was hit";
+    if (hits[i] > 0) {
+      ASSERT_EQ(s.layer(i), 0) << "particle " << i << " above the bottom layer was hit";
+    }
   // Facing away from the grid it never enters it.
   zero_hits(cl(), d);
   EXPECT_EQ(tracer.trace(s.lamp(-0.01f, -1.0f), 20000, 3, 1, d.hits).absorbed, 0u);
@@ -390,7 +394,9 @@ TEST_F(PhotonTracerTest, AbsorbedFractionMatchesTheViewFactorOfASmallBox) {
   const auto hits = read_hits(cl(), d);
   EXPECT_EQ(sum(hits), tally.absorbed);
   for (std::size_t i = 0; i < hits.size(); ++i)
-    if (hits[i] > 0) ASSERT_GE(i, 16u) << "particle " << i << " of the lower layer was hit";
+    if (hits[i] > 0) {
+      ASSERT_GE(i, 16u) << "particle " << i << " of the lower layer was hit";
+    }
 
   // A tilted 0.3 m x 0.2 m lamp off to the side sees the top and two side faces: against a host
   // Monte Carlo of the same emitter and box.
