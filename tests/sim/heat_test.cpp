@@ -177,6 +177,29 @@ TEST_F(HeatTest, LampPointedAwayHeatsNothing) {
   EXPECT_EQ(s.energy_budget().lamp_escaped, s.energy_budget().lamp_emitted);
 }
 
+TEST_F(HeatTest, LampSwitchedOffEmitsNothingAndCanBeTurnedAround) {
+  const Scene scene = scene_from_json(lamp_scene({0, 0, -1}));
+  Solver s(cl(), scene, initial_state(scene));
+  Lamp lamp = s.lamps().at(0);
+  lamp.on = false;
+  s.set_lamp(0, lamp);
+  for (int k = 0; k < 5; ++k) s.step();
+  EXPECT_EQ(s.energy_budget().lamp_emitted, 0.0);
+  EXPECT_EQ(s.energy_budget().lamps, 0.0);
+  lamp.on = true;
+  lamp.normal = {0, 0, 1};  // facing away from the ice
+  s.set_lamp(0, lamp);
+  for (int k = 0; k < 5; ++k) s.step();
+  EXPECT_GT(s.energy_budget().lamp_emitted, 0.0);
+  EXPECT_EQ(s.energy_budget().lamps, 0.0);
+  lamp.normal = {0, 0, -2};  // back towards it; need not be unit length
+  s.set_lamp(0, lamp);
+  for (int k = 0; k < 5; ++k) s.step();
+  EXPECT_GT(s.energy_budget().lamps, 0.0);
+  lamp.emissivity = 1.5;
+  EXPECT_THROW(s.set_lamp(0, lamp), SceneError);
+}
+
 TEST_F(HeatTest, HeldSolidAndTankWallsAccountTheirHeat) {
   Json doc = warm_block_scene();
   doc["domain"]["walls"] = {"-z"};
