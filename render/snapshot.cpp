@@ -1,0 +1,35 @@
+#include "render/snapshot.h"
+
+#include <limits>
+
+#include "sim/error.h"
+
+namespace thaw {
+
+RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& temperature, const Scene& scene,
+                             double time, std::uint64_t step) {
+  if (!temperature.empty() && temperature.size() != p.size())
+    throw Error("render snapshot: " + std::to_string(temperature.size()) + " temperatures for " +
+                std::to_string(p.size()) + " particles");
+  RenderSnapshot s;
+  s.position.reserve(p.size());
+  s.bounds_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
+  s.bounds_max = -s.bounds_min;
+  for (const Float4& x : p.position) {
+    const Eigen::Vector3f v(x[0], x[1], x[2]);
+    s.position.push_back(v);
+    s.bounds_min = s.bounds_min.cwiseMin(v);
+    s.bounds_max = s.bounds_max.cwiseMax(v);
+  }
+  if (p.size() == 0) s.bounds_min = s.bounds_max = Eigen::Vector3f::Zero();
+  s.phase = p.phase;
+  s.temperature = temperature;
+  s.spacing = static_cast<float>(scene.spacing);
+  s.domain_min = scene.domain.min.cast<float>();
+  s.domain_max = scene.domain.max.cast<float>();
+  s.time = time;
+  s.step = step;
+  return s;
+}
+
+}  // namespace thaw

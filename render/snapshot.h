@@ -1,0 +1,28 @@
+#pragma once
+// What the renderer draws: a read-only copy of the particles taken between simulation steps, so that
+// rendering never touches the simulation's buffers (DESIGN.md: render reads a snapshot).
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "sim/particles.h"
+#include "sim/scene.h"
+
+namespace thaw {
+
+struct RenderSnapshot {
+  std::vector<Eigen::Vector3f> position;  // [m]
+  std::vector<std::uint8_t> phase;        // thaw::Phase
+  std::vector<float> temperature;         // [°C]; empty when the scene has no heat
+  float spacing = 0;                      // particle spacing [m]
+  Eigen::Vector3f domain_min = Eigen::Vector3f::Zero(), domain_max = Eigen::Vector3f::Zero();
+  Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(), bounds_max = Eigen::Vector3f::Zero();  // of every particle
+  double time = 0;
+  std::uint64_t step = 0;
+};
+
+// `temperature` may be empty; otherwise one per particle in p's order.
+RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& temperature, const Scene& scene,
+                             double time, std::uint64_t step);
+
+}  // namespace thaw
