@@ -1,5 +1,7 @@
 #include "sim/thermal.h"
 
+#include "sim/solver.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -61,6 +63,19 @@ double temperature_at(const MaterialThermal& m, double h) {
 double liquid_fraction_at(const MaterialThermal& m, double h) {
   if (m.latent <= 0) return h > 0 ? 1.0 : 0.0;
   return std::clamp(h / m.latent, 0.0, 1.0);
+}
+
+std::vector<float> temperatures_of(const HostParticles& p, const Scene& scene) {
+  std::vector<float> out;
+  if (!scene.heat.enabled || p.enthalpy.size() != p.size()) return out;
+  const int layers = scene.wall_layers > 0 ? scene.wall_layers
+                                           : static_cast<int>(std::ceil(scene.solver.support_ratio - 1e-9));
+  const auto table = material_thermal_table(scene, derive_constants(scene).rest_density, layers);
+  out.reserve(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i)
+    out.push_back(static_cast<float>(
+        temperature_at(table[p.material[i]], double(p.enthalpy[i][0]) + double(p.enthalpy[i][1]))));
+  return out;
 }
 
 double max_diffusivity(const Scene& scene) {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "sim/kernels/thermal_law.h"
+#include "sim/particles.h"
 #include "sim/scene.h"
 
 namespace thaw {
@@ -21,6 +22,10 @@ double enthalpy_at(const Scene& scene, int material, double temperature);
 // Temperature [°C] and liquid fraction from a particle's enthalpy.
 double temperature_at(const MaterialThermal& m, double enthalpy);
 double liquid_fraction_at(const MaterialThermal& m, double enthalpy);
+
+// Temperatures [°C] of a particle set (e.g. read from a state file), one per particle; empty when the
+// scene has no heat or the particles carry no enthalpy.
+std::vector<float> temperatures_of(const HostParticles& p, const Scene& scene);
 
 // Thermal diffusivity k / (rho c) of the most diffusive material [m^2/s] that some particle has or can
 // turn into (held solids excepted): it sets the diffusion time-step limit.
