@@ -1,0 +1,124 @@
+// The particle and slice views: colours by phase and temperature, and their colour bar.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "render/particle_view.h"
+#include "sim/error.h"
+#include "sim/particles.h"
+
+namespace thaw {
+namespace {
+
+RenderSnapshot two_particles(float cold, float hot) {
+  RenderSnapshot s;
+  s.position = {{-0.05f, 0.0f, 0.0f}, {0.05f, 0.0f, 0.0f}};
+  s.phase = {static_cast<std::uint8_t>(Phase::Ice), static_cast<std::uint8_t>(Phase::Water)};
+  s.temperature = {cold, hot};
+  s.spacing = 0.02f;
+  s.domain_min = {-0.1f, -0.1f, -0.1f};
+  s.domain_max = {0.1f, 0.1f, 0.1f};
+  return s;
+}
+
+OrbitCamera front_camera() {
+  OrbitCamera c;
+  c.azimuth = -90;  // looking along +y: x runs left to right
+  c.elevation = 0;
+  c.distance = 0.4;
+  c.width = 320;
+  c.height = 240;
+  return c;
+}
+
+// Direction of a colour, so shading (a common factor) drops out.
+Eigen::Vector3d chroma(const std::uint8_t* p) { return Eigen::Vector3d(p[0], p[1], p[2]).normalized(); }
+Eigen::Vector3d chroma(const Rgb& c) { return Eigen::Vector3d(c[0], c[1], c[2]).normalized(); }
+
+// The pixel a world point projects to.
+void project(const OrbitCamera& c, const Eigen::Vector3f& x, int& px, int& py) {
+  const Eigen::Vector4f v = c.view() * Eigen::Vector4f(x.x(), x.y(), x.z(), 1.0f);
+  const double f = 0.5 * c.height / std::tan(0.5 * c.fov * M_PI / 180.0);
+  px = static_cast<int>(std::lround(0.5 * c.width + f * v.x() / -v.z() - 0.5));
+  py = static_cast<int>(std::lround(0.5 * c.height - f * v.y() / -v.z() - 0.5));
+}
+
+TEST(ParticleView, TemperatureColoursMapAKnownHotAndColdParticleToTheColourBarEnds) {
+  const RenderSnapshot s = two_particles(-10.0f, 50.0f);
+  const OrbitCamera cam = front_camera();
+  ParticleViewOptions o;
+  o.colour_by = "temperature";
+  const ViewImage v = render_particles(s, cam, o);
+  EXPECT_DOUBLE_EQ(v.t_min, -10.0);
+  EXPECT_DOUBLE_EQ(v.t_max, 50.0);
+  ASSERT_GT(v.bar.y1, v.bar.y0);
+  const std::uint8_t* bottom = v.image.pixel((v.bar.x0 + v.bar.x1) / 2, v.bar.y1 - 1);
+  const std::uint8_t* top = v.image.pixel((v.bar.x0 + v.bar.x1) / 2, v.bar.y0);
+  int x = 0, y = 0;
+  project(cam, s.position[0], x, y);
+  const std::uint8_t* cold = v.image.pixel(x, y);
+  project(cam, s.position[1], x, y);
+  const std::uint8_t* hot = v.image.pixel(x, y);
+  EXPECT_GT(chroma(cold).dot(chroma(bottom)), 0.999) << "cold particle has the bar's bottom colour";
+  EXPECT_GT(chroma(hot).dot(chroma(top)), 0.999) << "hot particle has the bar's top colour";
+  EXPECT_GT(chroma(bottom).dot(chroma(cool_warm(0.0))), 0.9999);
+  EXPECT_GT(chroma(top).dot(chroma(cool_warm(1.0))), 0.9999);
+  EXPECT_LT(chroma(cold).dot(chroma(hot)), 0.9) << "the two ends differ";
+}
+
+TEST(ParticleView, PhaseColoursTellIceFromWater) {
+  const RenderSnapshot s = two_particles(0.0f, 0.0f);
+  const OrbitCamera cam = front_camera();
+  const ViewImage v = render_particles(s, cam, {});
+  int x = 0, y = 0;
+  project(cam, s.position[0], x, y);
+  const Eigen::Vector3d ice = chroma(v.image.pixel(x, y));
+  project(cam, s.position[1], x, y);
+  const Eigen::Vector3d water = chroma(v.image.pixel(x, y));
+  EXPECT_GT(ice.dot(chroma(phase_rgb(static_cast<std::uint8_t>(Phase::Ice)))), 0.999);
+  EXPECT_GT(water.dot(chroma(phase_rgb(static_cast<std::uint8_t>(Phase::Water)))), 0.999);
+  EXPECT_LT(ice.dot(water), 0.97);
+}
+
+TEST(ParticleView, UnknownColouringAndMissingTemperaturesAreErrors) {
+  RenderSnapshot s = two_particles(0.0f, 1.0f);
+  ParticleViewOptions o;
+  o.colour_by = "speed";
+  EXPECT_THROW(render_particles(s, front_camera(), o), Error);
+  s.temperature.clear();
+  o.colour_by = "temperature";
+  EXPECT_THROW(render_particles(s, front_camera(), o), Error);
+}
+
+// T = 100 x on a lattice: the slice through it runs from the bar's bottom colour on the left to the
+// top colour on the right, through the middle of the scale at x = 0.
+TEST(SliceView, LinearTemperatureRunsAcrossTheColourBar) {
+  RenderSnapshot s;
+  s.spacing = 0.01f;
+  s.domain_min = {-0.1f, -0.05f, -0.05f};
+  s.domain_max = {0.1f, 0.05f, 0.05f};
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 10; ++j)
+      for (int k = 0; k < 10; ++k) {
+        const Eigen::Vector3f x(-0.095f + 0.01f * i, -0.045f + 0.01f * j, -0.045f + 0.01f * k);
+        s.position.push_back(x);
+        s.phase.push_back(static_cast<std::uint8_t>(Phase::Water));
+        s.temperature.push_back(100.0f * x.x());
+      }
+  SliceOptions o;
+  o.axis = 1;
+  o.t_min = -10;
+  o.t_max = 10;
+  o.width = 400;
+  o.height = 200;
+  const ViewImage v = render_slice(s, o);
+  // The plane spans x in [-0.1, 0.1] across the image, scaled by 1.05 around its centre.
+  auto column_of = [&](double x) { return static_cast<int>(std::lround(0.5 * o.width + x / (0.2 * 1.05 / o.width))); };
+  const int y = o.height / 2;
+  EXPECT_GT(chroma(v.image.pixel(column_of(-0.09), y)).dot(chroma(cool_warm(0.05))), 0.995);
+  EXPECT_GT(chroma(v.image.pixel(column_of(0.0), y)).dot(chroma(cool_warm(0.5))), 0.995);
+  EXPECT_GT(chroma(v.image.pixel(column_of(0.09), y)).dot(chroma(cool_warm(0.95))), 0.995);
+}
+
+}  // namespace
+}  // namespace thaw
