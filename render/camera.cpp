@@ -11,7 +11,8 @@ constexpr double kDeg = M_PI / 180.0;
 
 Eigen::Vector3d OrbitCamera::eye() const {
   const double a = azimuth * kDeg, e = elevation * kDeg;
-  return target + distance * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+  return target +
+         distance * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
 }
 
 Eigen::Matrix4f OrbitCamera::view() const {

@@ -9,10 +9,14 @@ namespace thaw {
 
 Rgb phase_rgb(std::uint8_t phase) {
   switch (static_cast<Phase>(phase)) {
-    case Phase::Water: return {40, 110, 230};
-    case Phase::Ice: return {190, 235, 255};
-    case Phase::Solid: return {150, 150, 150};
-    case Phase::Air: return {255, 255, 255};
+    case Phase::Water:
+      return {40, 110, 230};
+    case Phase::Ice:
+      return {190, 235, 255};
+    case Phase::Solid:
+      return {150, 150, 150};
+    case Phase::Air:
+      return {255, 255, 255};
   }
   return {255, 0, 255};
 }

@@ -74,13 +74,15 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, cons
     const Eigen::Vector4f c = view * s.position[i].homogeneous();
     const double z = -c.z();  // distance along the view direction
     if (z <= radius) continue;
-    const double px = 0.5 * cam.width + focal * c.x() / z - 0.5, py = 0.5 * cam.height - focal * c.y() / z - 0.5;
+    const double px = 0.5 * cam.width + focal * c.x() / z - 0.5,
+                 py = 0.5 * cam.height - focal * c.y() / z - 0.5;
     const double r = std::max(0.75, focal * radius / z);
     Rgb colour = by_t && !(static_cast<Phase>(s.phase[i]) == Phase::Solid)
                      ? cool_warm((s.temperature[i] - out.t_min) / (out.t_max - out.t_min))
                      : phase_rgb(s.phase[i]);
     const int x0 = std::max(0, int(std::floor(px - r))), x1 = std::min(cam.width - 1, int(std::ceil(px + r)));
-    const int y0 = std::max(0, int(std::floor(py - r))), y1 = std::min(cam.height - 1, int(std::ceil(py + r)));
+    const int y0 = std::max(0, int(std::floor(py - r))),
+              y1 = std::min(cam.height - 1, int(std::ceil(py + r)));
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const double u = (x - px) / r, v = (py - y) / r, d2 = u * u + v * v;
@@ -92,7 +94,8 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, cons
         zb = zz;
         const double shade = 0.35 + 0.65 * std::max(0.0, u * light.x() + v * light.y() + nz * light.z());
         std::uint8_t* p = &out.image.rgba[(std::size_t(y) * cam.width + x) * 4];
-        for (int k = 0; k < 3; ++k) p[k] = static_cast<std::uint8_t>(std::lround(colour[std::size_t(k)] * shade));
+        for (int k = 0; k < 3; ++k)
+          p[k] = static_cast<std::uint8_t>(std::lround(colour[std::size_t(k)] * shade));
       }
   }
   if (by_t) out.bar = draw_colour_bar(out.image);

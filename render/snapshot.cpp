@@ -6,8 +6,8 @@
 
 namespace thaw {
 
-RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& temperature, const Scene& scene,
-                             double time, std::uint64_t step) {
+RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& temperature,
+                             const Scene& scene, double time, std::uint64_t step) {
   if (!temperature.empty() && temperature.size() != p.size())
     throw Error("render snapshot: " + std::to_string(temperature.size()) + " temperatures for " +
                 std::to_string(p.size()) + " particles");

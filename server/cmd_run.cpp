@@ -3,12 +3,17 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 
+#include "render/image_io.h"
+#include "render/mesh_export.h"
+#include "render/snapshot.h"
 #include "server/cli_args.h"
 #include "server/commands.h"
 #include "server/progress.h"
+#include "server/render_options.h"
 #include "sim/error.h"
 #include "sim/metrics.h"
 #include "sim/particle_export.h"
@@ -31,9 +36,11 @@ Json stage_ms(const StageTimers& t, std::uint64_t steps) {
 }  // namespace
 
 int cmd_run(int argc, char** argv) {
-  CliArgs args(argc, argv, 2,
-               {"--until", "--steps", "--metrics", "--export", "--every", "--state-out", "--state-in", "--device"},
-               {"--quiet", "--no-progress"});
+  std::vector<std::string> with_value = {"--until",  "--steps",       "--metrics",     "--export",
+                                         "--every",  "--state-out",   "--state-in",    "--device",
+                                         "--frames", "--export-mesh", "--mesh-format"};
+  for (const char* o : kRenderValueOptions) with_value.emplace_back(o);
+  CliArgs args(argc, argv, 2, with_value, {"--quiet", "--no-progress"});
   if (args.positional().size() > 1) throw Error("run takes one scene, got " + std::to_string(args.positional().size()));
   const bool has_scene = !args.positional().empty();
   const auto state_in = args.value("--state-in");
@@ -77,6 +84,31 @@ int cmd_run(int argc, char** argv) {
   }
   std::unique_ptr<ParticleExporter> exporter;
   if (auto d = args.value("--export")) exporter = std::make_unique<ParticleExporter>(*d);
+  // Frames (PNG, off-screen) and meshes share the snapshot of a step.
+  const RenderOptions render = render_options(args);
+  const auto frames_dir = args.value("--frames");
+  std::unique_ptr<FrameRenderer> renderer;
+  if (frames_dir) {
+    std::error_code ec;
+    std::filesystem::create_directories(*frames_dir, ec);
+    if (ec) throw Error("cannot create frames directory '" + *frames_dir + "': " + ec.message());
+    renderer = std::make_unique<FrameRenderer>(render);
+  }
+  std::unique_ptr<MeshExporter> meshes;
+  if (auto d = args.value("--export-mesh")) meshes = std::make_unique<MeshExporter>(*d, args.value("--mesh-format").value_or("obj"));
+  std::uint64_t frame = 0;
+  auto picture = [&] {
+    if (!renderer && !meshes) return;
+    const RenderSnapshot snap =
+        make_snapshot(solver.particles(), solver.temperatures(), scene, solver.time(), solver.steps());
+    if (renderer) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%06llu.png", static_cast<unsigned long long>(frame));
+      write_png((std::filesystem::path(*frames_dir) / name).string(), renderer->render(snap));
+    }
+    if (meshes) meshes->write(snap, render.field);
+    ++frame;
+  };
 
   const auto counts = solver.particles();
   if (!quiet)
@@ -114,12 +146,16 @@ int cmd_run(int argc, char** argv) {
   write_metrics();
   auto export_frame = [&] { exporter->write(solver.particles(), solver.time(), solver.temperatures()); };
   if (exporter) export_frame();
+  picture();
 
   const auto t0 = Clock::now();
   while (!done() && !g_stop) {
     solver.step();
     ++interval_steps;
-    if (exporter && (solver.steps() - first_step) % std::uint64_t(every) == 0) export_frame();
+    if ((solver.steps() - first_step) % std::uint64_t(every) == 0) {
+      if (exporter) export_frame();
+      picture();
+    }
     if (solver.time() >= next_output - 1e-12) {
       write_metrics();
       next_output = (std::floor(solver.time() / interval + 1e-9) + 1.0) * interval;

@@ -15,11 +15,14 @@ const char* kUsage =
     "\n"
     "commands:\n"
     "  run SCENE        headless run: --until S | --steps N, --set PATH=VALUE, --metrics FILE.jsonl,\n"
-    "                   --export DIR --every K, --state-out FILE, --state-in FILE, --device D\n"
+    "                   --export DIR, --frames DIR, --export-mesh DIR [--mesh-format obj|ply], every\n"
+    "                   --every K steps; --state-out FILE, --state-in FILE, --device D\n"
     "  validate CASE    a validation case against its reference: --res R, --set, --json; --list\n"
     "  bench throughput µs per particle-step per stage, with a hand-written reference loop (--json)\n"
     "  bench accuracy CASE  error against run time over resolutions (--res 10,15,20 --out DIR)\n"
-    "  info             OpenCL platforms and devices, and the one that would be used\n"
+    "  render STATE     one frame of a state file: --out FILE.png, --size WxH, --camera AZ,EL[,DIST],\n"
+    "                   --view surface, --field-cells N\n"
+    "  info             OpenCL platforms and devices, and the one that would be used; the renderer\n"
     "  scene-doc        the scene file reference (docs/SCENES.md)\n"
     "\n"
     "Scenes are JSON files in configs/ (see docs/SCENES.md); --device or THAW_DEVICE picks the OpenCL\n"
@@ -39,6 +42,7 @@ int main(int argc, char** argv) {
     if (cmd == "bench") return thaw::cmd_bench(argc, argv);
     if (cmd == "info") return thaw::cmd_info(argc, argv);
     if (cmd == "scene-doc") return thaw::cmd_scene_doc(argc, argv);
+    if (cmd == "render") return thaw::cmd_render(argc, argv);
     std::fprintf(stderr, "thaw: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;
   } catch (const thaw::BlowUpError& e) {

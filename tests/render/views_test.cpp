@@ -100,7 +100,7 @@ TEST(SliceView, LinearTemperatureRunsAcrossTheColourBar) {
   for (int i = 0; i < 20; ++i)
     for (int j = 0; j < 10; ++j)
       for (int k = 0; k < 10; ++k) {
-        const Eigen::Vector3f x(-0.095f + 0.01f * i, -0.045f + 0.01f * j, -0.045f + 0.01f * k);
+        const Eigen::Vector3f x(-0.095f + 0.01f * float(i), -0.045f + 0.01f * float(j), -0.045f + 0.01f * float(k));
         s.position.push_back(x);
         s.phase.push_back(static_cast<std::uint8_t>(Phase::Water));
         s.temperature.push_back(100.0f * x.x());
@@ -113,7 +113,9 @@ TEST(SliceView, LinearTemperatureRunsAcrossTheColourBar) {
   o.height = 200;
   const ViewImage v = render_slice(s, o);
   // The plane spans x in [-0.1, 0.1] across the image, scaled by 1.05 around its centre.
-  auto column_of = [&](double x) { return static_cast<int>(std::lround(0.5 * o.width + x / (0.2 * 1.05 / o.width))); };
+  auto column_of = [&](double x) {
+    return static_cast<int>(std::lround(0.5 * o.width + x / (0.2 * 1.05 / o.width)));
+  };
   const int y = o.height / 2;
   EXPECT_GT(chroma(v.image.pixel(column_of(-0.09), y)).dot(chroma(cool_warm(0.05))), 0.995);
   EXPECT_GT(chroma(v.image.pixel(column_of(0.0), y)).dot(chroma(cool_warm(0.5))), 0.995);

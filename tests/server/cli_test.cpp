@@ -220,6 +220,51 @@ TEST(ThawCli, HeatRunReportsTheEnergyBudgetAndExportsTemperature) {
   EXPECT_TRUE(testing::read_file_bytes(dir / "full.state") == testing::read_file_bytes(dir / "resumed.state"));
 }
 
+// Off-screen output from the command line: PNG frames and meshes during a run, any view of a state
+// file afterwards, and clear errors for bad rendering options.
+TEST(ThawCli, FramesMeshesAndRenderedStates) {
+  TempDir dir("cli-render");
+  const auto r = run_thaw(
+      "run ice-on-plate --steps 4 --set spacing=0.006 --frames frames --export-mesh meshes --mesh-format ply "
+      "--every 2 --size 160x120 --state-out s.state --no-progress --quiet",
+      dir);
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  for (const char* f : {"frames/frame_000000.png", "frames/frame_000002.png", "meshes/ice_000000.ply",
+                        "meshes/ice_000002.ply"})
+    EXPECT_TRUE(fs::exists(dir.path() / f)) << f;
+  const std::string png = testing::read_file_bytes(dir.path() / "frames/frame_000001.png");
+  ASSERT_GT(png.size(), 8u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+
+  for (const char* view : {"surface", "particles --colour-by temperature", "slice --slice x,0.5"}) {
+    const auto v = run_thaw(std::string("render s.state --out v.png --size 120x90 --view ") + view, dir);
+    ASSERT_TRUE(v.exited && v.exit_code == 0) << view << "\n" << describe(v);
+    EXPECT_TRUE(fs::exists(dir.path() / "v.png")) << view;
+    fs::remove(dir.path() / "v.png");
+  }
+  for (const char* bad : {"--view wireframe", "--size 10x10", "--camera 30", "--slice w,0.5", "--colour-by speed"}) {
+    const auto b = run_thaw(std::string("render s.state --out b.png ") + bad, dir);
+    ASSERT_TRUE(b.exited) << bad;
+    EXPECT_EQ(b.exit_code, 2) << bad;
+    EXPECT_NE(b.err.find(std::string(bad).substr(0, std::string(bad).find(' '))), std::string::npos)
+        << "the error names the option: " << b.err;
+  }
+  const auto missing = run_thaw("render nowhere.state --out b.png", dir);
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("nowhere.state"), std::string::npos) << missing.err;
+  const auto fmt = run_thaw("run ice-on-plate --steps 1 --set spacing=0.006 --export-mesh m --mesh-format stl", dir);
+  EXPECT_EQ(fmt.exit_code, 2);
+  EXPECT_NE(fmt.err.find("stl"), std::string::npos) << fmt.err;
+}
+
+TEST(ThawCli, InfoNamesTheRenderer) {
+  TempDir dir("cli-info-render");
+  const auto r = run_thaw("info", dir);
+  ASSERT_TRUE(r.exited);
+  EXPECT_NE(r.out.find("renderer: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("OpenGL ES"), std::string::npos) << r.out;
+}
+
 TEST(ThawCli, SceneDocMatchesTheCommittedReference) {
   TempDir dir("cli-scene-doc");
   const auto r = run_thaw("scene-doc", dir);

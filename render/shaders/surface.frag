@@ -1,0 +1,260 @@
+#version 300 es
+// Ray caster of the metaball iso-surfaces (DESIGN.md, Renderer; render/surface_renderer.h describes the
+// textures). Everything runs in grid units (one unit = one cell; the grid is axis-aligned with cubic
+// cells, so world directions are grid directions).
+//
+// Per pixel: clip the ray to the box of nodes; march the union field one cell at a time, jumping over
+// empty space with the blocks' distance map; refine the first crossing by bisection; shade by phase:
+//   solid  opaque neutral grey: Lambert + hemispheric ambient;
+//   ice    Fresnel reflection over a milky pale blue: light scattered inside, in front of what lies
+//          behind, both weighted by Beer-Lambert extinction along the path through the ice;
+//   water  the same with little scattering and a stronger, bluer absorption: clear and tinted.
+// Translucent phases show what lies behind them along the straight ray (no refraction), shaded opaque.
+// Contact cues: ambient occlusion from the fields along the normal, and soft shadows from the blocks'
+// precomputed light transmittance.
+//
+// llvmpipe runs this on the CPU, a group of pixels in lock-step: a loop costs its longest lane, and
+// both sides of a divergent branch run. Hence the refinement after the loop, not in it, and few
+// fetches per hit.
+precision highp float;
+precision highp int;
+precision highp sampler3D;
+
+uniform sampler3D u_field;   // max of the phases, linear
+uniform sampler3D u_phases;  // ice, water, solid in [0, 1], linear
+uniform sampler3D u_blocks;  // per block: skip distance, fraction inside, light transmittance
+uniform int u_has_volume;
+uniform vec3 u_nodes;        // nodes per axis
+uniform vec3 u_block_count;  // blocks per axis
+uniform float u_block;       // cells per block along an axis
+uniform float u_iso;
+uniform float u_scale;       // 1 / cells along the longest axis: optical depths are per grid length
+uniform vec3 u_eye;          // grid units
+uniform vec3 u_forward, u_right, u_up;
+uniform vec2 u_viewport;
+uniform vec3 u_light;        // unit vector toward the key light
+
+out vec4 o_colour;
+
+const int kMaxSteps = 1024;    // march iterations (jumps and steps)
+const int kBisections = 5;     // 1/32 cell
+const int kMaxInside = 128;    // steps through ice or water
+const float kInsideStep = 3.0;  // cells; absorption needs the path length, not every detail of it
+
+// Optical constants per grid length (the longest axis): a body a third of the grid across is clearly
+// tinted, a thin film nearly clear, whatever the scene's size in metres.
+const vec3 kIceColour = vec3(0.82, 0.91, 0.98);
+const float kIceScattering = 6.0;
+const float kIceMinScatter = 0.35;  // thin ice still reads as ice, not glass
+const vec3 kIceAbsorption = vec3(2.0, 0.8, 0.35);
+const vec3 kWaterColour = vec3(0.08, 0.30, 0.52);
+const float kWaterScattering = 1.5;
+const vec3 kWaterAbsorption = vec3(4.5, 1.6, 0.6);
+const vec3 kSolidColour = vec3(0.56, 0.56, 0.54);
+// Fresnel reflectance at normal incidence, ((n - 1) / (n + 1))^2 with n = 1.31 (ice), 1.33 (water).
+const float kIceF0 = 0.018;
+const float kWaterF0 = 0.020;
+
+vec3 tex_coord(vec3 g) { return (g + 0.5) / u_nodes; }
+float field(vec3 g) { return texture(u_field, tex_coord(g)).r; }
+vec3 phases(vec3 g) { return texture(u_phases, tex_coord(g)).rgb; }
+// Block b's texel centre lies at the centre of its cells, (b + 0.5) * u_block.
+vec4 coarse(vec3 g) { return texture(u_blocks, g / (u_block * u_block_count)); }
+
+// 0 = ice, 1 = water, 2 = solid: the phase with the largest field.
+int dominant(vec3 ph) {
+  if (ph.b >= ph.r && ph.b >= ph.g) return 2;
+  return ph.r >= ph.g ? 0 : 1;
+}
+
+// Neutral grey, lighter above the horizon: no colour of its own to confuse with ice or water.
+vec3 background(vec3 d) {
+  return mix(vec3(0.30, 0.31, 0.33), vec3(0.84, 0.85, 0.87), smoothstep(-0.7, 0.9, d.z));
+}
+
+// The parameter interval of the ray inside the box of nodes; x > y when it misses.
+vec2 clip_to_box(vec3 o, vec3 inv) {
+  vec3 ta = -o * inv, tb = (u_nodes - 1.0 - o) * inv;
+  vec3 lo = min(ta, tb), hi = max(ta, tb);
+  return vec2(max(max(lo.x, lo.y), max(lo.z, 0.0)), min(min(hi.x, hi.y), hi.z));
+}
+
+// The first t in [t0, t1] where the union field reaches iso, or -1. In a block at Chebyshev distance k
+// from any block with surface, the cube of blocks within k - 1 of it is empty: jump to where the ray
+// leaves that cube. Elsewhere step one cell.
+float first_hit(vec3 o, vec3 d, vec3 inv, float t0, float t1) {
+  float t = t0;
+  if (field(o + t * d) >= u_iso) return t;
+  vec3 forward = step(0.0, d);
+  float hi = -1.0;
+  for (int i = 0; i < kMaxSteps; ++i) {
+    if (t >= t1) break;
+    vec3 b = clamp(floor((o + t * d) / u_block), vec3(0.0), u_block_count - 1.0);
+    float k = texelFetch(u_blocks, ivec3(b), 0).r;
+    if (k > 0.0) {
+      // The push past the face keeps rounding from landing back inside the cube.
+      vec3 far = ((b + forward * (2.0 * k - 1.0) - (k - 1.0)) * u_block - o) * inv;
+      t = max(min(min(far.x, far.y), far.z), t) + 1e-3;
+      continue;
+    }
+    float tn = min(t + 1.0, t1);
+    if (field(o + tn * d) >= u_iso) {
+      hi = tn;
+      break;
+    }
+    t = tn;
+  }
+  if (hi < 0.0) return -1.0;
+  float lo = t;
+  for (int k = 0; k < kBisections; ++k) {
+    float m = 0.5 * (lo + hi);
+    if (field(o + m * d) >= u_iso)
+      hi = m;
+    else
+      lo = m;
+  }
+  return hi;
+}
+
+// Outward unit normal, minus the field gradient, from four samples on a tetrahedron's corners instead
+// of six central differences (same first-order accuracy; Quilez, "normals for an SDF").
+vec3 outward_normal(vec3 p, vec3 d) {
+  const vec2 e = vec2(1.0, -1.0);
+  vec3 g = e.xyy * field(p + e.xyy) + e.yyx * field(p + e.yyx) + e.yxy * field(p + e.yxy) +
+           e.xxx * field(p + e.xxx);
+  float len = length(g);
+  return len > 1e-6 ? -g / len : -d;
+}
+
+// Ambient occlusion: how much of the space just outside the surface, along the normal, is inside some
+// phase. Near contacts (ice on a floor) the normal runs into the other body; the far sample reads the
+// blocks' inside fraction, a wider neighbourhood.
+float occlusion(vec3 p, vec3 n) {
+  float near = smoothstep(u_iso - 0.05, u_iso + 0.05, field(p + n * 2.5));
+  float far = coarse(p + n * 2.0 * u_block).g;
+  return clamp(1.0 - 0.45 * near - 0.55 * far, 0.0, 1.0);
+}
+
+// Transmittance toward the light, read a block off the surface so a body does not shadow itself where
+// it faces the light.
+float shadow(vec3 p, vec3 n) { return coarse(p + n * u_block).b; }
+
+vec3 ambient(vec3 n) { return mix(vec3(0.55), vec3(1.0), 0.5 + 0.5 * n.z); }
+
+vec3 diffuse(vec3 base, vec3 n, float ao, float sh) {
+  return base * (0.38 * ambient(n) * ao + 0.72 * max(dot(n, u_light), 0.0) * sh);
+}
+
+vec3 lit(vec3 base, vec3 p, vec3 n) { return diffuse(base, n, occlusion(p, n), shadow(p, n)); }
+
+void main() {
+  vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
+  vec3 d = normalize(u_forward + ndc.x * u_right + ndc.y * u_up);
+  vec3 colour = background(d);
+  if (u_has_volume == 0) {
+    o_colour = vec4(colour, 1.0);
+    return;
+  }
+  // Keep 1/d finite: an axis-parallel ray would give 0 * inf = NaN at the box faces.
+  d = mix(d, mix(vec3(1e-6), vec3(-1e-6), lessThan(d, vec3(0.0))), lessThan(abs(d), vec3(1e-6)));
+  vec3 inv = 1.0 / d;
+  vec2 span = clip_to_box(u_eye, inv);
+  float t = span.x > span.y ? -1.0 : first_hit(u_eye, d, inv, span.x, span.y);
+  if (t < 0.0) {
+    o_colour = vec4(colour, 1.0);
+    return;
+  }
+  vec3 p = u_eye + t * d;
+  int phase = dominant(phases(p));
+  vec3 n;
+  if (t == span.x && span.x > 0.0) {
+    // A phase cut by the box: the face the ray came in through is its surface.
+    vec3 lo = min(-u_eye * inv, (u_nodes - 1.0 - u_eye) * inv);
+    n = -sign(d) * step(span.x - 1e-4, lo);
+    n = length(n) > 0.0 ? normalize(n) : -d;
+  } else {
+    n = outward_normal(p, d);
+  }
+  float ao = occlusion(p, n), sh = shadow(p, n);
+  if (phase == 2) {
+    o_colour = vec4(diffuse(kSolidColour, n, ao, sh), 1.0);
+    return;
+  }
+
+  // Walk through ice and water to their far side, or to a solid inside them, summing the path in each.
+  // One RGBA8 fetch per step tells all three phases apart. The exit is then refined by bisection
+  // (after the loop, as in first_hit): a path quantised to whole steps shows as contour bands.
+  float path_ice = 0.0, path_water = 0.0, w = phase == 0 ? 1.0 : 0.0;  // w: the ice share of the medium
+  float tb = t, tn = t;
+  bool left = false;
+  for (int i = 0; i < kMaxInside; ++i) {
+    tn = min(tb + kInsideStep, span.y);
+    vec3 ph = phases(u_eye + tn * d);
+    if (max(ph.r, ph.g) < u_iso || tn >= span.y) {
+      left = true;
+      break;
+    }
+    w = ph.r / (ph.r + ph.g);
+    path_ice += (tn - tb) * w;
+    path_water += (tn - tb) * (1.0 - w);
+    tb = tn;
+  }
+  bool solid_behind = false;
+  if (left) {
+    float inside_to = tb;
+    for (int k = 0; k < kBisections; ++k) {
+      float m = 0.5 * (inside_to + tn);
+      vec3 ph = phases(u_eye + m * d);
+      if (max(ph.r, ph.g) < u_iso)
+        tn = m;
+      else
+        inside_to = m;
+    }
+    path_ice += (tn - tb) * w;
+    path_water += (tn - tb) * (1.0 - w);
+    // Where a medium meets a solid both fields sit near iso at the exit: look a cell further.
+    solid_behind = phases(u_eye + (tn + 1.0) * d).b >= u_iso;
+    tb = tn;
+  }
+
+  // What lies behind, shaded opaque: the next surface along the ray, or the background.
+  vec3 back = background(d);
+  if (solid_behind) {
+    // The union field is flat across a medium-solid interface; the solid's own field has the normal.
+    vec3 q = u_eye + tb * d;
+    const vec2 e = vec2(1.0, -1.0);
+    vec3 g = e.xyy * phases(q + e.xyy).b + e.yyx * phases(q + e.yyx).b + e.yxy * phases(q + e.yxy).b +
+             e.xxx * phases(q + e.xxx).b;
+    back = lit(kSolidColour, q, length(g) > 1e-6 ? -normalize(g) : -d);
+  } else if (left && tb + 1.0 < span.y) {
+    // From a cell beyond the exit: at the exit itself the float field may still read above iso (the
+    // exit was found on the 8-bit phases) and the medium would hit its own back face.
+    float t2 = first_hit(u_eye, d, inv, tb + 1.0, span.y);
+    if (t2 >= 0.0) {
+      vec3 q = u_eye + t2 * d;
+      int behind = dominant(phases(q));
+      back = lit(behind == 2 ? kSolidColour : behind == 0 ? kIceColour * 0.85 : kWaterColour * 1.4, q,
+                 outward_normal(q, d));
+    }
+  }
+
+  // Beer-Lambert along the path: absorption dims what lies behind; scattering replaces it with the
+  // medium's own colour, lit with wrap-around diffuse since light diffuses inside it.
+  float li = path_ice * u_scale, lw = path_water * u_scale;
+  vec3 transmitted = back * exp(-(kIceAbsorption * li + kWaterAbsorption * lw));
+  float scatter = phase == 0 ? max(1.0 - exp(-kIceScattering * li), kIceMinScatter)
+                             : 1.0 - exp(-kWaterScattering * lw);
+  float wrap = 0.5 + 0.5 * dot(n, u_light);
+  vec3 medium = (phase == 0 ? kIceColour : kWaterColour) * (0.45 * ambient(n) * ao + 0.65 * wrap * sh);
+  vec3 body = mix(transmitted, medium, scatter);
+
+  // Schlick's approximation of the Fresnel reflectance (Schlick 1994, "An inexpensive BRDF model for
+  // physically-based rendering"), reflecting the background, plus a highlight of the key light.
+  float f0 = phase == 0 ? kIceF0 : kWaterF0;
+  float fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(n, -d), 0.0, 1.0), 5.0);
+  vec3 r = reflect(d, n);
+  float shininess = phase == 0 ? 40.0 : 120.0;  // ice's surface is rougher than water's
+  float highlight = (phase == 0 ? 0.35 : 0.8) * pow(max(dot(r, u_light), 0.0), shininess) * sh;
+  colour = mix(body, background(r), fresnel) + highlight;
+  o_colour = vec4(clamp(colour, 0.0, 1.0), 1.0);
+}

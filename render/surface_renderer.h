@@ -1,0 +1,78 @@
+#pragma once
+// The metaball view (DESIGN.md, Renderer): the iso-surfaces of the ice, water and solid density fields,
+// ray-marched in a fragment shader (render/shaders/surface.frag) into an off-screen RGBA8 framebuffer
+// and read back as an Image.
+//
+// What goes to the GPU per frame, and why:
+//   u_field   R32F, one node per texel: the max of the three phases. Its iso-surface is the union of
+//             the phases' surfaces, so the march reads one texture per step (a 32-bit float fetch is the
+//             cheapest on llvmpipe; DESIGN.md, machine facts).
+//   u_phases  RGBA8: ice, water, solid clamped to [0, 1]; read only at hits and inside ice and water to
+//             tell the phases apart, where 8 bits around iso are plenty.
+//   u_blocks  RGBA32F, one texel per block of kBlock^3 cells. R: empty-space skipping, the Chebyshev
+//             distance in blocks to the nearest block that may hold surface (one with a node at or above
+//             iso; trilinear values never exceed their nodes), so a ray jumps out of the whole empty cube
+//             around it at once (a distance map, as in Cohen & Sheffer 1994, "Proximity clouds"). G: the
+//             fraction of the block's nodes inside any phase (wide ambient occlusion). B: transmittance
+//             toward the key light, marched on the CPU over the blocks (soft shadows for one fetch).
+// Without OES_texture_float_linear the float textures fall back to R16F/RGBA16F, filterable in ES 3.0.
+#include <GLES3/gl3.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "render/camera.h"
+#include "render/density_field.h"
+#include "render/egl_context.h"
+#include "render/image.h"
+
+namespace thaw {
+
+class SurfaceRenderer {
+ public:
+  // Builds the shaders; `context` must be current on this thread whenever the renderer is used.
+  explicit SurfaceRenderer(EglContext& context);
+  ~SurfaceRenderer();
+  SurfaceRenderer(const SurfaceRenderer&) = delete;
+  SurfaceRenderer& operator=(const SurfaceRenderer&) = delete;
+
+  // Uploads `fields` and draws them as seen by `camera` (camera.width x camera.height pixels).
+  Image render(const DensityFields& fields, const OrbitCamera& camera);
+  // Draws the fields uploaded last from another camera, e.g. orbiting a paused scene (no upload).
+  Image render(const OrbitCamera& camera);
+
+  struct Times {
+    double upload_ms = 0;    // CPU preparation (max field, phases, blocks) and texture upload
+    double march_ms = 0;     // the draw, to completion (glFinish)
+    double readback_ms = 0;  // glReadPixels and the row flip
+  };
+  Times last_times() const { return times_; }
+
+  static constexpr int kBlock = 4;         // cells per empty-space block along each axis
+  static constexpr int kMaxSkip = 16;      // blocks (64 cells): the cap of the distance map
+  static constexpr int kShadowSteps = 16;  // blocks toward the light that can shadow a point
+  // Shadow extinction per cell of light path inside ice, water, solid: translucent phases cast pale
+  // shadows, solids dark ones.
+  static constexpr float kShadowExtinction[3] = {0.06f, 0.02f, 0.45f};
+
+ private:
+  void upload(const DensityFields& fields);
+  void resize_volume(int nx, int ny, int nz);
+  void resize_target(int width, int height);
+
+  EglContext& context_;
+  GLuint program_ = 0, vao_ = 0, fbo_ = 0, colour_ = 0;
+  GLuint field_ = 0, phases_ = 0, blocks_ = 0;
+  int width_ = 0, height_ = 0;
+  int nodes_[3] = {0, 0, 0}, block_count_[3] = {0, 0, 0};
+  bool has_volume_ = false;
+  FieldGrid grid_;
+  float iso_ = 0.5f;
+  // Staging buffers, kept between frames so a steady stream of uploads does not reallocate.
+  std::vector<float> max_field_, block_data_, extinction_;
+  std::vector<std::uint8_t> phase_bytes_, skip_distance_;
+  Times times_;
+};
+
+}  // namespace thaw

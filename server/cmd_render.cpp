@@ -1,0 +1,44 @@
+// `thaw render STATE --out FILE.png`: one frame of a state file, off-screen.
+#include <cstdio>
+
+#include "render/image_io.h"
+#include "server/cli_args.h"
+#include "server/commands.h"
+#include "server/render_options.h"
+#include "sim/error.h"
+#include "sim/state_file.h"
+#include "sim/thermal.h"
+
+namespace thaw {
+
+int cmd_render(int argc, char** argv) {
+  std::vector<std::string> with_value = {"--out"};
+  for (const char* o : kRenderValueOptions) with_value.emplace_back(o);
+  CliArgs args(argc, argv, 2, with_value, {"--quiet"});
+  if (args.positional().size() != 1) throw Error("render takes one state file (from thaw run --state-out)");
+  const auto out = args.value("--out");
+  if (!out) throw Error("render needs --out FILE.png");
+  const RenderOptions o = render_options(args);
+
+  const SimState state = read_state_file(args.positional()[0]);
+  const Scene scene = scene_from_json(Json::parse(state.scene_json));
+  const RenderSnapshot snap =
+      make_snapshot(state.particles, temperatures_of(state.particles, scene), scene, state.time, state.step);
+
+  FrameRenderer renderer(o);
+  write_png(*out, renderer.render(snap));
+  if (!args.flag("--quiet")) {
+    const auto& t = renderer.last_times();
+    std::printf("thaw render: %s, t = %.6g s, %dx%d %s view -> %s (", args.positional()[0].c_str(), state.time,
+                o.width, o.height, o.view.c_str(), out->c_str());
+    if (o.view == "surface")
+      std::printf("field %.1f ms, upload %.1f ms, march %.1f ms, read-back %.1f ms", t.field_ms, t.upload_ms,
+                  t.march_ms, t.readback_ms);
+    else
+      std::printf("draw %.1f ms", t.draw_ms);
+    std::printf(") on %s\n", renderer.description().c_str());
+  }
+  return 0;
+}
+
+}  // namespace thaw

@@ -1,0 +1,133 @@
+#include "server/render_options.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "sim/error.h"
+
+namespace thaw {
+
+RenderOptions render_options(const CliArgs& args) {
+  RenderOptions o;
+  if (auto v = args.value("--view")) {
+    if (*v != "surface" && *v != "particles" && *v != "slice")
+      throw Error("--view: unknown view '" + *v + "'; available: surface, particles, slice");
+    o.view = *v;
+  }
+  if (auto v = args.value("--colour-by")) {
+    if (*v != "phase" && *v != "temperature")
+      throw Error("--colour-by: unknown colouring '" + *v + "'; available: phase, temperature");
+    o.colour_by = *v;
+  }
+  if (auto v = args.value("--slice")) {
+    const std::string axis = v->substr(0, v->find(','));
+    if (axis != "x" && axis != "y" && axis != "z")
+      throw Error("--slice: expected AXIS[,FRACTION] with AXIS x, y or z, e.g. y,0.5, got '" + *v + "'");
+    o.slice_axis = axis[0] - 'x';
+    if (v->find(',') != std::string::npos) {
+      const std::string f = v->substr(v->find(',') + 1);
+      std::size_t used = 0;
+      double d = -1;
+      try {
+        d = std::stod(f, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != f.size() || !(d >= 0 && d <= 1))
+        throw Error("--slice: the fraction must be a number in [0, 1], got '" + f + "'");
+      o.slice_position = d;
+    }
+  }
+  if (auto v = args.value("--size")) {
+    int w = 0, h = 0;
+    char x = 0, rest = 0;
+    std::istringstream in(*v);
+    if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> rest) || w < 16 || h < 16 || w > 8192 || h > 8192)
+      throw Error("--size: expected WIDTHxHEIGHT between 16 and 8192 pixels, e.g. 640x480, got '" + *v + "'");
+    o.width = w;
+    o.height = h;
+  }
+  if (auto v = args.value("--camera")) {
+    std::istringstream in(*v);
+    double values[3] = {0, 0, 0};
+    int n = 0;
+    for (std::string part; n < 4 && std::getline(in, part, ',');) {
+      std::size_t used = 0;
+      double d = 0;
+      try {
+        d = std::stod(part, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != part.size() || !std::isfinite(d) || n >= 3)
+        throw Error("--camera: expected AZIMUTH,ELEVATION[,DISTANCE] in degrees and metres, e.g. 30,25 or "
+                    "30,25,0.4, got '" + *v + "'");
+      values[n++] = d;
+    }
+    if (n < 2) throw Error("--camera: expected AZIMUTH,ELEVATION[,DISTANCE], got '" + *v + "'");
+    if (std::abs(values[1]) >= 90.0) throw Error("--camera: elevation must be between -90 and 90 degrees");
+    if (n == 3 && values[2] <= 0) throw Error("--camera: distance must be positive");
+    o.azimuth = values[0];
+    o.elevation = values[1];
+    if (n == 3) o.distance = values[2];
+  }
+  if (auto v = args.value("--field-cells")) {
+    const long long cells = args.integer("--field-cells", 128);
+    if (cells < 16 || cells > 512) throw Error("--field-cells: expected 16..512, got '" + *v + "'");
+    o.field.max_cells = static_cast<int>(cells);
+  }
+  return o;
+}
+
+OrbitCamera camera_for(const RenderOptions& o, const RenderSnapshot& s) {
+  OrbitCamera c = OrbitCamera::framing(s.domain_min.cast<double>(), s.domain_max.cast<double>(), o.azimuth,
+                                       o.elevation, o.width, o.height);
+  if (o.distance > 0) c.distance = o.distance;
+  return c;
+}
+
+FrameRenderer::FrameRenderer(RenderOptions options) : options_(std::move(options)) {
+  if (options_.view == "surface") {
+    gl_ = std::make_unique<EglContext>();
+    surface_ = std::make_unique<SurfaceRenderer>(*gl_);
+  }
+}
+
+Image FrameRenderer::render(const RenderSnapshot& s) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  auto since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  times_ = {};
+  if (surface_) {
+    const DensityFields fields = build_density_fields(s, options_.field);
+    times_.field_ms = since(t0);
+    Image image = surface_->render(fields, camera_for(options_, s));
+    const auto t = surface_->last_times();
+    times_.upload_ms = t.upload_ms;
+    times_.march_ms = t.march_ms;
+    times_.readback_ms = t.readback_ms;
+    return image;
+  }
+  ViewImage v;
+  if (options_.view == "particles") {
+    ParticleViewOptions p;
+    p.colour_by = options_.colour_by;
+    v = render_particles(s, camera_for(options_, s), p);
+  } else {
+    SliceOptions o;
+    o.axis = options_.slice_axis;
+    o.position = options_.slice_position;
+    o.width = options_.width;
+    o.height = options_.height;
+    v = render_slice(s, o);
+  }
+  times_.draw_ms = since(t0);
+  return v.image;
+}
+
+std::string FrameRenderer::description() const {
+  return gl_ ? gl_->description() : std::string("CPU (") + options_.view + " view)";
+}
+
+}  // namespace thaw

@@ -1,0 +1,58 @@
+#pragma once
+// The rendering options `thaw render` and `thaw run --frames` share: image size, camera, view.
+#include <memory>
+#include <string>
+
+#include "render/camera.h"
+#include "render/density_field.h"
+#include "render/egl_context.h"
+#include "render/image.h"
+#include "render/particle_view.h"
+#include "render/snapshot.h"
+#include "render/surface_renderer.h"
+#include "server/cli_args.h"
+
+namespace thaw {
+
+struct RenderOptions {
+  std::string view = "surface";         // surface | particles | slice
+  std::string colour_by = "phase";      // particles: phase | temperature
+  int slice_axis = 1;                   // slice: the plane's normal axis
+  double slice_position = 0.5;          // slice: fraction of the domain along it
+  int width = 640, height = 480;
+  double azimuth = 30.0, elevation = 25.0;
+  double distance = 0.0;  // 0: frame the domain
+  FieldOptions field;
+};
+
+// The option names, for CliArgs: --size WxH, --camera AZ,EL[,DIST], --view NAME, --colour-by phase|temperature,
+// --slice AXIS[,FRACTION], --field-cells N.
+inline const char* const kRenderValueOptions[] = {"--size",  "--camera", "--view", "--colour-by",
+                                                  "--slice", "--field-cells"};
+
+// Reads the options; a malformed value is an Error naming the option and what was expected.
+RenderOptions render_options(const CliArgs& args);
+
+// The camera for a snapshot: the options' angles, framing the scene's domain unless a distance is given.
+OrbitCamera camera_for(const RenderOptions& o, const RenderSnapshot& s);
+
+// Renders snapshots in the options' view; the EGL context is made only for the surface view.
+class FrameRenderer {
+ public:
+  explicit FrameRenderer(RenderOptions options);
+  Image render(const RenderSnapshot& s);
+  // Milliseconds of the last frame by stage: field, upload, march, read-back (surface), or draw (others).
+  struct Times {
+    double field_ms = 0, upload_ms = 0, march_ms = 0, readback_ms = 0, draw_ms = 0;
+  };
+  const Times& last_times() const { return times_; }
+  std::string description() const;
+
+ private:
+  RenderOptions options_;
+  std::unique_ptr<EglContext> gl_;
+  std::unique_ptr<SurfaceRenderer> surface_;
+  Times times_;
+};
+
+}  // namespace thaw

@@ -1,0 +1,350 @@
+// The renderer's parts, headless (CI has no GPU: Mesa llvmpipe through EGL's surfaceless platform):
+// the EGL context, PNG/JPEG encoding, the ray caster against analytic fields whose images are known
+// (a sphere's silhouette, ice against water, a golden image), and CPU picking.
+#include <gtest/gtest.h>
+#include <turbojpeg.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <random>
+
+#include "render/egl_context.h"
+#include "render/image_io.h"
+#include "render/picking.h"
+#include "render/surface_renderer.h"
+#include "sim/error.h"
+#include "tests/test_support.h"
+
+namespace thaw {
+namespace {
+
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+// An empty field grid of n nodes along its longest axis over the box [lo, hi].
+DensityFields empty_fields(const Vector3f& lo, const Vector3f& hi, int n) {
+  DensityFields f;
+  f.grid.origin = lo;
+  f.grid.cell = (hi - lo).maxCoeff() / float(n - 1);
+  f.grid.nx = int(std::lround((hi.x() - lo.x()) / f.grid.cell)) + 1;
+  f.grid.ny = int(std::lround((hi.y() - lo.y()) / f.grid.cell)) + 1;
+  f.grid.nz = int(std::lround((hi.z() - lo.z()) / f.grid.cell)) + 1;
+  f.ice.assign(f.grid.size(), 0.0f);
+  f.water.assign(f.grid.size(), 0.0f);
+  f.solid.assign(f.grid.size(), 0.0f);
+  return f;
+}
+
+// Adds a body given by its signed distance: f = clamp(0.5 - sdf / width, 0, 1), so the iso 0.5 surface
+// is the zero set of sdf and the field ramps over `width` metres around it (a sphere of radius R with
+// width R gives f = clamp(1.5 - r / R, 0, 1)).
+void add_body(DensityFields& f, std::vector<float>& phase, const std::function<float(const Vector3f&)>& sdf,
+              float width) {
+  const FieldGrid& g = f.grid;
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const Vector3f p = g.origin + g.cell * Vector3f(float(i), float(j), float(k));
+        float& v = phase[g.index(i, j, k)];
+        v = std::max(v, std::clamp(0.5f - sdf(p) / width, 0.0f, 1.0f));
+      }
+}
+
+std::function<float(const Vector3f&)> sphere(const Vector3f& c, float r) {
+  return [c, r](const Vector3f& p) { return (p - c).norm() - r; };
+}
+
+std::function<float(const Vector3f&)> box(const Vector3f& lo, const Vector3f& hi) {
+  return [lo, hi](const Vector3f& p) {
+    const Vector3f c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
+    const Vector3f q = (p - c).cwiseAbs() - h;
+    return q.cwiseMax(0.0f).norm() + std::min(q.maxCoeff(), 0.0f);
+  };
+}
+
+// A sphere of radius R at the origin, alone in a grid over [-1.5 R, 1.5 R]^3 (the field is 0 at the box).
+DensityFields sphere_fields(std::vector<float> DensityFields::*phase, float radius, int n) {
+  DensityFields f = empty_fields(Vector3f::Constant(-1.5f * radius), Vector3f::Constant(1.5f * radius), n);
+  add_body(f, f.*phase, sphere(Vector3f::Zero(), radius), radius);
+  return f;
+}
+
+// The golden scene: an ice sphere resting on a solid slab, beside a water block standing on it. `cubic`
+// puts it in a cube of n^3 nodes (the timings' 128^3), otherwise in a box fitted around it.
+DensityFields scene_fields(int n, bool cubic = false) {
+  DensityFields f = cubic ? empty_fields(Vector3f(-0.40f, -0.40f, -0.12f), Vector3f(0.40f, 0.40f, 0.68f), n)
+                          : empty_fields(Vector3f(-0.40f, -0.30f, -0.12f), Vector3f(0.40f, 0.30f, 0.30f), n);
+  const float w = 2.0f * f.grid.cell;  // a ramp of two cells, like particle metaballs
+  add_body(f, f.solid, box({-0.36f, -0.26f, -0.08f}, {0.36f, 0.26f, 0.0f}), w);
+  add_body(f, f.ice, sphere({-0.13f, 0.0f, 0.11f}, 0.11f), w);
+  add_body(f, f.water, box({0.04f, -0.18f, 0.0f}, {0.32f, 0.18f, 0.10f}), w);
+  return f;
+}
+
+OrbitCamera scene_camera(int width, int height) {
+  OrbitCamera c = OrbitCamera::framing({-0.36, -0.26, -0.08}, {0.36, 0.26, 0.22}, 35.0, 28.0, width, height);
+  c.distance *= 0.85;
+  return c;
+}
+
+// A camera looking at the origin from `distance` with the sphere at the image centre.
+OrbitCamera centred_camera(double distance, int width, int height) {
+  OrbitCamera c;
+  c.azimuth = 20.0;
+  c.elevation = 15.0;
+  c.distance = distance;
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
+bool differs(const Image& a, const Image& b, int x, int y, int tolerance) {
+  for (int ch = 0; ch < 3; ++ch)
+    if (std::abs(int(a.pixel(x, y)[ch]) - int(b.pixel(x, y)[ch])) > tolerance) return true;
+  return false;
+}
+
+double psnr(const Image& a, const Image& b) {
+  double se = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x)
+      for (int ch = 0; ch < 3; ++ch) {
+        const double e = double(a.pixel(x, y)[ch]) - double(b.pixel(x, y)[ch]);
+        se += e * e;
+      }
+  const double mse = se / (3.0 * a.width * a.height);
+  return mse == 0 ? 999.0 : 10.0 * std::log10(255.0 * 255.0 / mse);
+}
+
+// One context and renderer for the suite: llvmpipe compiles the shader on first use (~100 ms).
+class RenderTest : public ::testing::Test {
+ public:
+  static void SetUpTestSuite() {
+    context_ = std::make_unique<EglContext>();
+    renderer_ = std::make_unique<SurfaceRenderer>(*context_);
+  }
+  static void TearDownTestSuite() {
+    renderer_.reset();
+    context_.reset();
+  }
+
+ protected:
+  static SurfaceRenderer& renderer() { return *renderer_; }
+  // The picture with no fields: the background alone.
+  static Image background(const OrbitCamera& camera) {
+    DensityFields none;
+    return renderer().render(none, camera);
+  }
+
+ private:
+  static inline std::unique_ptr<EglContext> context_;
+  static inline std::unique_ptr<SurfaceRenderer> renderer_;
+};
+
+TEST(EglContextTest, CreatesAndDescribesItself) {
+  EglContext context;
+  EXPECT_FALSE(context.renderer().empty());
+  EXPECT_GE(context.gl_major(), 3);
+  EXPECT_NE(context.description().find(context.renderer()), std::string::npos);
+  EXPECT_TRUE(context.platform() == "surfaceless" || context.platform().rfind("device", 0) == 0);
+  std::printf("[ info ] %s\n", context.description().c_str());
+}
+
+TEST(EglContextTest, TwoContextsShareOneDisplay) {
+  auto a = std::make_unique<EglContext>();
+  {
+    EglContext b;  // same display: destroying b must not terminate it under a
+  }
+  a->make_current();
+  EXPECT_NE(glGetString(GL_RENDERER), nullptr);
+}
+
+TEST(EglContextTest, ShaderErrorsNameTheFile) {
+  EglContext context;
+  try {
+    build_program("fullscreen.vert", "no_such_shader.frag");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_shader.frag"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ImageIoTest, PngRoundTripIsExact) {
+  Image image(37, 23);
+  std::mt19937 rng(7);
+  for (auto& b : image.rgba) b = static_cast<std::uint8_t>(rng());
+  const std::string png = encode_png(image);
+  ASSERT_GE(png.size(), 8u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  const Image back = decode_png(png);
+  EXPECT_EQ(back.width, image.width);
+  EXPECT_EQ(back.height, image.height);
+  EXPECT_EQ(back.rgba, image.rgba);
+}
+
+TEST(ImageIoTest, JpegIsJfifOfTheRightSize) {
+  Image image(64, 48);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      std::uint8_t* p = image.pixel(x, y);
+      p[0] = std::uint8_t(4 * x);
+      p[1] = std::uint8_t(5 * y);
+      p[2] = 128;
+      p[3] = 255;
+    }
+  const std::string jpeg = encode_jpeg(image, 80);
+  ASSERT_GE(jpeg.size(), 4u);
+  EXPECT_EQ(std::uint8_t(jpeg[0]), 0xFF);
+  EXPECT_EQ(std::uint8_t(jpeg[1]), 0xD8);
+  tjhandle tj = tjInitDecompress();
+  int w = 0, h = 0, subsampling = 0, colourspace = 0;
+  EXPECT_EQ(tjDecompressHeader3(tj, reinterpret_cast<const unsigned char*>(jpeg.data()),
+                                static_cast<unsigned long>(jpeg.size()), &w, &h, &subsampling, &colourspace),
+            0);
+  tjDestroy(tj);
+  EXPECT_EQ(w, 64);
+  EXPECT_EQ(h, 48);
+}
+
+TEST(ImageIoTest, ErrorsSayWhatFailed) {
+  EXPECT_THROW(decode_png("not a png"), Error);
+  Image bad;
+  bad.width = 4;
+  bad.height = 4;
+  bad.rgba.resize(10);
+  EXPECT_THROW(encode_png(bad), Error);
+  EXPECT_THROW(encode_jpeg(Image(4, 4), 0), Error);
+  try {
+    encode_jpeg(bad, 80);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("JPEG"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ImageIoTest, WritePngReplacesTheFile) {
+  testing::TempDir dir("image");
+  Image image(5, 3);
+  image.pixel(4, 2)[0] = 200;
+  const std::string path = dir / "a.png";
+  write_png(path, image);
+  write_png(path, image);
+  EXPECT_EQ(decode_png(testing::read_file_bytes(path)).rgba, image.rgba);
+  EXPECT_THROW(write_png((dir / "missing") + "/a.png", image), Error);
+}
+
+TEST_F(RenderTest, SphereSilhouetteHasTheProjectedArea) {
+  const double radius = 0.1, distance = 0.4;
+  const DensityFields f = sphere_fields(&DensityFields::solid, float(radius), 128);
+  const OrbitCamera camera = centred_camera(distance, 640, 480);
+  const Image bg = background(camera);
+  const Image image = renderer().render(f, camera);
+  long count = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) count += differs(image, bg, x, y, 2);
+  // A sphere seen from its centre's direction projects to a disc of angular radius asin(R / d).
+  const double tan_half = std::tan(0.5 * camera.fov * M_PI / 180.0);
+  const double r_px = std::tan(std::asin(radius / distance)) / tan_half * 0.5 * camera.height;
+  const double area = M_PI * r_px * r_px;
+  std::printf("[ info ] silhouette %ld px, projected disc %.0f px\n", count, area);
+  EXPECT_NEAR(double(count), area, 0.03 * area);
+  // The centre is covered, the corners are background.
+  EXPECT_TRUE(differs(image, bg, 320, 240, 2));
+  EXPECT_FALSE(differs(image, bg, 2, 2, 2));
+}
+
+TEST_F(RenderTest, IceAndWaterLookDifferent) {
+  const OrbitCamera camera = centred_camera(0.4, 160, 120);
+  const Image bg = background(camera);
+  auto mean_colour = [&](std::vector<float> DensityFields::*phase) {
+    const Image image = renderer().render(sphere_fields(phase, 0.1f, 64), camera);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    long n = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        if (differs(image, bg, x, y, 2)) {
+          for (int ch = 0; ch < 3; ++ch) sum[ch] += image.pixel(x, y)[ch];
+          ++n;
+        }
+    EXPECT_GT(n, 1000);
+    return Eigen::Vector3d(sum / double(std::max(n, 1L)));
+  };
+  const Eigen::Vector3d ice = mean_colour(&DensityFields::ice), water = mean_colour(&DensityFields::water),
+                        solid = mean_colour(&DensityFields::solid);
+  std::printf("[ info ] mean RGB  ice %.0f %.0f %.0f  water %.0f %.0f %.0f  solid %.0f %.0f %.0f\n", ice[0],
+              ice[1], ice[2], water[0], water[1], water[2], solid[0], solid[1], solid[2]);
+  EXPECT_GT(ice[2], ice[0] + 10) << "ice should be blue-ish";
+  EXPECT_GT(water[2], water[0] + 10) << "water should be blue-ish";
+  EXPECT_GT((ice - water).norm(), 40.0);
+  EXPECT_LT(std::abs(solid[2] - solid[0]), 10.0) << "solids should be neutral";
+}
+
+TEST_F(RenderTest, MatchesTheGoldenImage) {
+  const fs::path golden = fs::path(THAW_SOURCE_DIR) / "tests/render/golden/surface_160x120.png";
+  const Image image = renderer().render(scene_fields(96), scene_camera(160, 120));
+  const char* update = std::getenv("THAW_UPDATE_GOLDEN");
+  if (!fs::exists(golden) || (update && std::string(update) == "1")) {
+    const bool missing = !fs::exists(golden);
+    write_png(golden.string(), image);
+    if (missing)
+      FAIL() << "wrote the missing golden image " << golden << "; look at it, commit it, run again";
+    std::printf("[ info ] rewrote %s (THAW_UPDATE_GOLDEN=1)\n", golden.c_str());
+    return;
+  }
+  const Image expected = decode_png(testing::read_file_bytes(golden));
+  ASSERT_EQ(expected.width, image.width);
+  ASSERT_EQ(expected.height, image.height);
+  const double p = psnr(image, expected);
+  EXPECT_GE(p, 30.0) << "PSNR " << p << " dB against " << golden
+                     << " (THAW_UPDATE_GOLDEN=1 rewrites it after a deliberate change)";
+}
+
+TEST_F(RenderTest, EmptyFieldsGiveTheBackground) {
+  const OrbitCamera camera = centred_camera(0.4, 64, 48);
+  const Image image = background(camera);
+  // Brighter above than below, neutral grey.
+  EXPECT_GT(image.pixel(32, 0)[1], image.pixel(32, 47)[1]);
+  EXPECT_LT(std::abs(int(image.pixel(32, 24)[0]) - int(image.pixel(32, 24)[2])), 12);
+}
+
+TEST_F(RenderTest, StageTimes) {
+  const DensityFields f = scene_fields(128, true);
+  std::printf("[ info ] golden scene in a %dx%dx%d field\n", f.grid.nx, f.grid.ny, f.grid.nz);
+  for (const auto& [w, h] : {std::pair{320, 240}, std::pair{640, 480}, std::pair{1280, 720}}) {
+    renderer().render(f, scene_camera(w, h));  // first use of a size: framebuffer allocation, warm-up
+    const Image image = renderer().render(f, scene_camera(w, h));
+    const auto t = renderer().last_times();
+    std::printf("[ info ] %4dx%-4d upload %6.1f ms  march %7.1f ms  readback %5.1f ms\n", w, h, t.upload_ms,
+                t.march_ms, t.readback_ms);
+    EXPECT_EQ(image.width, w);
+  }
+}
+
+TEST(PickingTest, CentreHitsTheSphereFacingTheCamera) {
+  const double radius = 0.1, distance = 0.4;
+  const DensityFields f = sphere_fields(&DensityFields::ice, float(radius), 128);
+  const OrbitCamera camera = centred_camera(distance, 640, 480);
+  Vector3d hit, normal, eye, dir;
+  camera.ray(camera.width / 2.0 - 0.5, camera.height / 2.0 - 0.5, eye, dir);
+  ASSERT_TRUE(pick(f, camera, camera.width / 2.0 - 0.5, camera.height / 2.0 - 0.5, hit, normal));
+  const Vector3d expected = eye + (distance - radius) * dir;
+  EXPECT_LT((hit - expected).norm(), 0.01 * radius) << hit.transpose() << " vs " << expected.transpose();
+  EXPECT_GT(normal.dot(-dir), 0.999);
+}
+
+TEST(PickingTest, MissReturnsFalse) {
+  const DensityFields f = sphere_fields(&DensityFields::water, 0.1f, 64);
+  const OrbitCamera camera = centred_camera(0.4, 640, 480);
+  Vector3d hit(7, 7, 7), normal;
+  EXPECT_FALSE(pick(f, camera, 0, 0, hit, normal));
+  EXPECT_EQ(hit, Vector3d(7, 7, 7));
+  EXPECT_FALSE(pick(DensityFields{}, camera, 320, 240, hit, normal));
+}
+
+}  // namespace
+}  // namespace thaw
