@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "bench/accuracy.h"
+#include "bench/render_bench.h"
 #include "bench/throughput.h"
 #include "server/cli_args.h"
 #include "server/commands.h"
@@ -32,7 +33,7 @@ std::vector<T> list_of(const std::string& text, const char* option) {
 }  // namespace
 
 int cmd_bench(int argc, char** argv) {
-  if (argc < 3) throw Error("bench needs a kind: throughput or accuracy");
+  if (argc < 3) throw Error("bench needs a kind: throughput, accuracy or render");
   const std::string kind = argv[2];
   if (kind == "throughput") {
     CliArgs args(argc, argv, 3, {"--sizes", "--steps", "--device"}, {"--json"});
@@ -58,7 +59,19 @@ int cmd_bench(int argc, char** argv) {
     if (args.flag("--json")) std::printf("%s\n", r.dump(2).c_str());
     return 0;
   }
-  throw Error("unknown bench '" + kind + "' (throughput, accuracy)");
+  if (kind == "render") {
+    CliArgs args(argc, argv, 3, {"--sizes", "--frames", "--field-cells"}, {"--json"});
+    RenderBenchOptions o;
+    if (auto s = args.value("--sizes")) o.sizes = list_of<std::size_t>(*s, "--sizes");
+    o.frames = static_cast<int>(args.integer("--frames", o.frames));
+    if (o.frames < 1) throw Error("--frames: must be >= 1");
+    o.field_cells = static_cast<int>(args.integer("--field-cells", o.field_cells));
+    if (o.field_cells < 16 || o.field_cells > 512) throw Error("--field-cells: expected 16..512");
+    const Json r = bench_render(o, !args.flag("--json"));
+    if (args.flag("--json")) std::printf("%s\n", r.dump(2).c_str());
+    return 0;
+  }
+  throw Error("unknown bench '" + kind + "' (throughput, accuracy, render)");
 }
 
 }  // namespace thaw

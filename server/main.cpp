@@ -20,6 +20,7 @@ const char* kUsage =
     "  validate CASE    a validation case against its reference: --res R, --set, --json; --list\n"
     "  bench throughput µs per particle-step per stage, with a hand-written reference loop (--json)\n"
     "  bench accuracy CASE  error against run time over resolutions (--res 10,15,20 --out DIR)\n"
+    "  bench render     ms per frame by stage (field, upload, march, read-back, JPEG) (--sizes, --json)\n"
     "  render STATE     one frame of a state file: --out FILE.png, --size WxH, --camera AZ,EL[,DIST],\n"
     "                   --view surface, --field-cells N\n"
     "  info             OpenCL platforms and devices, and the one that would be used; the renderer\n"
