@@ -1,7 +1,10 @@
-// `thaw render STATE --out FILE.png`: one frame of a state file, off-screen.
+// `thaw render STATE --out FILE.png [--pick X,Y]`: one frame of a state file, off-screen, and the surface
+// point under a pixel.
 #include <cstdio>
+#include <sstream>
 
 #include "render/image_io.h"
+#include "render/picking.h"
 #include "server/cli_args.h"
 #include "server/commands.h"
 #include "server/render_options.h"
@@ -12,7 +15,7 @@
 namespace thaw {
 
 int cmd_render(int argc, char** argv) {
-  std::vector<std::string> with_value = {"--out"};
+  std::vector<std::string> with_value = {"--out", "--pick"};
   for (const char* o : kRenderValueOptions) with_value.emplace_back(o);
   CliArgs args(argc, argv, 2, with_value, {"--quiet"});
   if (args.positional().size() != 1) throw Error("render takes one state file (from thaw run --state-out)");
@@ -25,6 +28,23 @@ int cmd_render(int argc, char** argv) {
   const RenderSnapshot snap =
       make_snapshot(state.particles, temperatures_of(state.particles, scene), scene, state.time, state.step);
 
+  if (auto v = args.value("--pick")) {
+    // The surface under a pixel, as the browser will aim a dryer: X,Y in pixels from the top left.
+    double px = 0, py = 0;
+    char comma = 0, rest = 0;
+    std::istringstream in(*v);
+    if (!(in >> px >> comma >> py) || comma != ',' || (in >> rest) || px < 0 || py < 0 || px >= o.width ||
+        py >= o.height)
+      throw Error("--pick: expected X,Y inside the " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                  " image, got '" + *v + "'");
+    Eigen::Vector3d hit, normal;
+    const DensityFields fields = build_density_fields(snap, o.field);
+    if (pick(fields, camera_for(o, snap), px, py, hit, normal))
+      std::printf("pick %g,%g: hit (%.6g, %.6g, %.6g) m, normal (%.4f, %.4f, %.4f)\n", px, py, hit.x(), hit.y(),
+                  hit.z(), normal.x(), normal.y(), normal.z());
+    else
+      std::printf("pick %g,%g: no surface\n", px, py);
+  }
   FrameRenderer renderer(o);
   write_png(*out, renderer.render(snap));
   if (!args.flag("--quiet")) {

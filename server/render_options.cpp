@@ -72,6 +72,28 @@ RenderOptions render_options(const CliArgs& args) {
     o.elevation = values[1];
     if (n == 3) o.distance = values[2];
   }
+  if (auto v = args.value("--target")) {
+    std::istringstream in(*v);
+    int n = 0;
+    for (std::string part; std::getline(in, part, ',');) {
+      std::size_t used = 0;
+      double d = 0;
+      try {
+        d = std::stod(part, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != part.size() || !std::isfinite(d) || n >= 3)
+        throw Error("--target: expected X,Y,Z in metres, e.g. 0.05,0.05,0.02, got '" + *v + "'");
+      o.target[n++] = d;
+    }
+    if (n != 3) throw Error("--target: expected X,Y,Z in metres, got '" + *v + "'");
+    o.has_target = true;
+  }
+  if (auto v = args.value("--fov")) {
+    o.fov = args.number("--fov", 40.0);
+    if (!(o.fov >= 5.0 && o.fov <= 120.0)) throw Error("--fov: expected 5..120 degrees, got '" + *v + "'");
+  }
   if (auto v = args.value("--field-cells")) {
     const long long cells = args.integer("--field-cells", 128);
     if (cells < 16 || cells > 512) throw Error("--field-cells: expected 16..512, got '" + *v + "'");
@@ -83,6 +105,13 @@ RenderOptions render_options(const CliArgs& args) {
 OrbitCamera camera_for(const RenderOptions& o, const RenderSnapshot& s) {
   OrbitCamera c = OrbitCamera::framing(s.domain_min.cast<double>(), s.domain_max.cast<double>(), o.azimuth,
                                        o.elevation, o.width, o.height);
+  if (o.has_target) c.target = o.target;
+  if (o.fov != c.fov) {
+    // Keep the framing: the distance that fits the domain scales with 1 / sin(fov / 2).
+    const double half_old = 0.5 * c.fov * M_PI / 180.0, half_new = 0.5 * o.fov * M_PI / 180.0;
+    c.distance *= std::sin(half_old) / std::sin(half_new);
+    c.fov = o.fov;
+  }
   if (o.distance > 0) c.distance = o.distance;
   return c;
 }

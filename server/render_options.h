@@ -22,13 +22,16 @@ struct RenderOptions {
   int width = 640, height = 480;
   double azimuth = 30.0, elevation = 25.0;
   double distance = 0.0;  // 0: frame the domain
+  bool has_target = false;
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();  // default: the domain's centre
+  double fov = 40.0;                                  // vertical [deg]
   FieldOptions field;
 };
 
-// The option names, for CliArgs: --size WxH, --camera AZ,EL[,DIST], --view NAME, --colour-by phase|temperature,
-// --slice AXIS[,FRACTION], --field-cells N.
-inline const char* const kRenderValueOptions[] = {"--size",  "--camera", "--view", "--colour-by",
-                                                  "--slice", "--field-cells"};
+// The option names, for CliArgs: --size WxH, --camera AZ,EL[,DIST], --target X,Y,Z, --fov DEG, --view NAME,
+// --colour-by phase|temperature, --slice AXIS[,FRACTION], --field-cells N.
+inline const char* const kRenderValueOptions[] = {"--size",      "--camera", "--target", "--fov", "--view",
+                                                  "--colour-by", "--slice",  "--field-cells"};
 
 // Reads the options; a malformed value is an Error naming the option and what was expected.
 RenderOptions render_options(const CliArgs& args);
