@@ -42,12 +42,14 @@ RenderSnapshot bench_snapshot(std::size_t particles) {
 Json bench_render(const RenderBenchOptions& o, bool print) {
   EglContext gl;
   SurfaceRenderer renderer(gl);
+  renderer.set_quality(o.fast ? SurfaceRenderer::Quality::Fast : SurfaceRenderer::Quality::Full);
   Json out;
+  out["quality"] = o.fast ? "fast" : "full";
   out["renderer"] = gl.description();
   out["unit"] = "milliseconds per frame, fastest of the timed frames";
   Json rows = Json::array();
   if (print) {
-    std::printf("renderer: %s\n", gl.description().c_str());
+    std::printf("renderer: %s, quality %s\n", gl.description().c_str(), o.fast ? "fast" : "full");
     std::printf("%-9s %-10s %8s %8s %8s %9s %8s %8s | %10s\n", "particles", "image", "field", "upload", "march",
                 "readback", "jpeg", "total", "cpu march");
   }

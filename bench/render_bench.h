@@ -12,6 +12,7 @@ struct RenderBenchOptions {
   std::vector<std::pair<int, int>> resolutions = {{320, 240}, {640, 480}, {1280, 720}};
   int frames = 5;         // timed frames per case, after one untimed; the fastest is reported
   int field_cells = 128;  // FieldOptions::max_cells
+  bool fast = false;      // SurfaceRenderer::Quality::Fast
 };
 
 // Sizes are particles of ice and water: a block of water with an ice cube standing in it.

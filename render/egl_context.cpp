@@ -159,7 +159,7 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
-GLuint compile(GLenum type, const std::string& file) {
+GLuint compile(GLenum type, const std::string& file, const std::string& defines) {
   const auto& files = embedded_shader_files();
   const auto it = files.find(file);
   if (it == files.end()) {
@@ -167,9 +167,16 @@ GLuint compile(GLenum type, const std::string& file) {
     for (const auto& [name, text] : files) have += " " + name;
     throw Error("shader " + file + ": no such file in render/shaders/ (embedded:" + have + ")");
   }
+  // Defines go after the #version line, which must come first; #line keeps the log's line numbers.
+  std::string source(it->second);
+  if (!defines.empty()) {
+    const std::size_t eol = source.find('\n');
+    source = eol == std::string::npos ? source + "\n" + defines
+                                      : source.substr(0, eol + 1) + defines + "#line 2\n" + source.substr(eol + 1);
+  }
   const GLuint shader = glCreateShader(type);
-  const GLchar* text = it->second.data();
-  const auto length = static_cast<GLint>(it->second.size());
+  const GLchar* text = source.data();
+  const auto length = static_cast<GLint>(source.size());
   glShaderSource(shader, 1, &text, &length);
   glCompileShader(shader);
   GLint ok = GL_FALSE;
@@ -298,11 +305,11 @@ bool EglContext::has_gl_extension(const std::string& name) const {
   return has_word(gl_extensions_.c_str(), name);
 }
 
-GLuint build_program(const std::string& vertex_file, const std::string& fragment_file) {
-  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file);
+GLuint build_program(const std::string& vertex_file, const std::string& fragment_file, const std::string& defines) {
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file, "");
   GLuint fs = 0;
   try {
-    fs = compile(GL_FRAGMENT_SHADER, fragment_file);
+    fs = compile(GL_FRAGMENT_SHADER, fragment_file, defines);
   } catch (...) {
     glDeleteShader(vs);
     throw;

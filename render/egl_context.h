@@ -51,6 +51,9 @@ class EglContext {
 // Compiles and links a program from files of render/shaders/ (embedded at build time). Each file is
 // compiled on its own; a failure throws thaw::Error with the file name and the driver's info log.
 // The caller owns the returned program (glDeleteProgram).
-GLuint build_program(const std::string& vertex_file, const std::string& fragment_file);
+// `defines` ("#define NAME VALUE\n" lines) are inserted into the fragment shader after its #version line:
+// variants that differ in code, not in uniforms, which llvmpipe pays for even when a branch is not taken.
+GLuint build_program(const std::string& vertex_file, const std::string& fragment_file,
+                     const std::string& defines = "");
 
 }  // namespace thaw

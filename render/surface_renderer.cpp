@@ -76,13 +76,27 @@ void chebyshev_distance(std::vector<std::uint8_t>& d, int nx, int ny, int nz) {
 }  // namespace
 
 SurfaceRenderer::SurfaceRenderer(EglContext& context) : context_(context) {
-  program_ = build_program("fullscreen.vert", "surface.frag");
   glGenVertexArrays(1, &vao_);
-  glUseProgram(program_);
-  glUniform1i(glGetUniformLocation(program_, "u_field"), 0);
-  glUniform1i(glGetUniformLocation(program_, "u_phases"), 1);
-  glUniform1i(glGetUniformLocation(program_, "u_blocks"), 2);
+  program_ = program_for(quality_);
+}
+
+GLuint SurfaceRenderer::program_for(Quality q) {
+  GLuint& p = programs_[q == Quality::Full ? 0 : 1];
+  if (p) return p;
+  // A variant per quality: a uniform switch left the fast frame as slow as the full one on llvmpipe.
+  p = build_program("fullscreen.vert", "surface.frag",
+                    std::string("#define THAW_SEE_BEHIND ") + (q == Quality::Full ? "1" : "0") + "\n");
+  glUseProgram(p);
+  glUniform1i(glGetUniformLocation(p, "u_field"), 0);
+  glUniform1i(glGetUniformLocation(p, "u_phases"), 1);
+  glUniform1i(glGetUniformLocation(p, "u_blocks"), 2);
   check_gl("setting up the surface shader");
+  return p;
+}
+
+void SurfaceRenderer::set_quality(Quality q) {
+  quality_ = q;
+  program_ = program_for(q);
 }
 
 SurfaceRenderer::~SurfaceRenderer() {
@@ -91,7 +105,8 @@ SurfaceRenderer::~SurfaceRenderer() {
   if (colour_) glDeleteRenderbuffers(1, &colour_);
   if (fbo_) glDeleteFramebuffers(1, &fbo_);
   if (vao_) glDeleteVertexArrays(1, &vao_);
-  if (program_) glDeleteProgram(program_);
+  for (GLuint p : programs_)
+    if (p) glDeleteProgram(p);
 }
 
 void SurfaceRenderer::resize_volume(int nx, int ny, int nz) {

@@ -60,13 +60,16 @@ int cmd_bench(int argc, char** argv) {
     return 0;
   }
   if (kind == "render") {
-    CliArgs args(argc, argv, 3, {"--sizes", "--frames", "--field-cells"}, {"--json"});
+    CliArgs args(argc, argv, 3, {"--sizes", "--frames", "--field-cells", "--quality"}, {"--json"});
     RenderBenchOptions o;
     if (auto s = args.value("--sizes")) o.sizes = list_of<std::size_t>(*s, "--sizes");
     o.frames = static_cast<int>(args.integer("--frames", o.frames));
     if (o.frames < 1) throw Error("--frames: must be >= 1");
     o.field_cells = static_cast<int>(args.integer("--field-cells", o.field_cells));
     if (o.field_cells < 16 || o.field_cells > 512) throw Error("--field-cells: expected 16..512");
+    const std::string quality = args.value("--quality").value_or("full");
+    if (quality != "full" && quality != "fast") throw Error("--quality: expected full or fast, got '" + quality + "'");
+    o.fast = quality == "fast";
     const Json r = bench_render(o, !args.flag("--json"));
     if (args.flag("--json")) std::printf("%s\n", r.dump(2).c_str());
     return 0;

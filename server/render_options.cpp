@@ -15,6 +15,10 @@ RenderOptions render_options(const CliArgs& args) {
       throw Error("--view: unknown view '" + *v + "'; available: surface, particles, slice");
     o.view = *v;
   }
+  if (auto v = args.value("--quality")) {
+    if (*v != "full" && *v != "fast") throw Error("--quality: expected full or fast, got '" + *v + "'");
+    o.quality = *v;
+  }
   if (auto v = args.value("--colour-by")) {
     if (*v != "phase" && *v != "temperature")
       throw Error("--colour-by: unknown colouring '" + *v + "'; available: phase, temperature");
@@ -120,6 +124,7 @@ FrameRenderer::FrameRenderer(RenderOptions options) : options_(std::move(options
   if (options_.view == "surface") {
     gl_ = std::make_unique<EglContext>();
     surface_ = std::make_unique<SurfaceRenderer>(*gl_);
+    surface_->set_quality(options_.quality == "fast" ? SurfaceRenderer::Quality::Fast : SurfaceRenderer::Quality::Full);
   }
 }
 

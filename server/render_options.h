@@ -17,6 +17,7 @@ namespace thaw {
 struct RenderOptions {
   std::string view = "surface";         // surface | particles | slice
   std::string colour_by = "phase";      // particles: phase | temperature
+  std::string quality = "full";         // surface: full | fast (SurfaceRenderer::Quality)
   int slice_axis = 1;                   // slice: the plane's normal axis
   double slice_position = 0.5;          // slice: fraction of the domain along it
   int width = 640, height = 480;
@@ -29,9 +30,9 @@ struct RenderOptions {
 };
 
 // The option names, for CliArgs: --size WxH, --camera AZ,EL[,DIST], --target X,Y,Z, --fov DEG, --view NAME,
-// --colour-by phase|temperature, --slice AXIS[,FRACTION], --field-cells N.
-inline const char* const kRenderValueOptions[] = {"--size",      "--camera", "--target", "--fov", "--view",
-                                                  "--colour-by", "--slice",  "--field-cells"};
+// --colour-by phase|temperature, --slice AXIS[,FRACTION], --field-cells N, --quality full|fast.
+inline const char* const kRenderValueOptions[] = {"--size",      "--camera", "--target",      "--fov",    "--view",
+                                                  "--colour-by", "--slice",  "--field-cells", "--quality"};
 
 // Reads the options; a malformed value is an Error naming the option and what was expected.
 RenderOptions render_options(const CliArgs& args);

@@ -36,6 +36,9 @@ uniform vec3 u_light;        // unit vector toward the key light
 
 out vec4 o_colour;
 
+#ifndef THAW_SEE_BEHIND
+#define THAW_SEE_BEHIND 1  // 1: find and shade the surface behind ice and water (SurfaceRenderer::Quality)
+#endif
 const int kMaxSteps = 1024;    // march iterations (jumps and steps)
 const int kBisections = 5;     // 1/32 cell
 const int kMaxInside = 128;    // steps through ice or water
@@ -226,7 +229,7 @@ void main() {
     vec3 g = e.xyy * phases(q + e.xyy).b + e.yyx * phases(q + e.yyx).b + e.yxy * phases(q + e.yxy).b +
              e.xxx * phases(q + e.xxx).b;
     back = lit(kSolidColour, q, length(g) > 1e-6 ? -normalize(g) : -d);
-  } else if (left && tb + 1.0 < span.y) {
+  } else if (THAW_SEE_BEHIND == 1 && left && tb + 1.0 < span.y) {
     // From a cell beyond the exit: at the exit itself the float field may still read above iso (the
     // exit was found on the 8-bit phases) and the medium would hit its own back face.
     float t2 = first_hit(u_eye, d, inv, tb + 1.0, span.y);

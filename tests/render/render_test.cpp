@@ -312,6 +312,26 @@ TEST_F(RenderTest, EmptyFieldsGiveTheBackground) {
   EXPECT_LT(std::abs(int(image.pixel(32, 24)[0]) - int(image.pixel(32, 24)[2])), 12);
 }
 
+// Fast quality drops only what shows through ice and water: a solid alone renders the same, while the
+// slab seen through the water block changes.
+TEST_F(RenderTest, FastQualityDiffersOnlyBehindIceAndWater) {
+  DensityFields solid_only = empty_fields(Vector3f(-0.40f, -0.30f, -0.12f), Vector3f(0.40f, 0.30f, 0.30f), 64);
+  add_body(solid_only, solid_only.solid, box({-0.36f, -0.26f, -0.08f}, {0.36f, 0.26f, 0.0f}),
+           2.0f * solid_only.grid.cell);
+  const DensityFields scene = scene_fields(64);
+  const OrbitCamera camera = scene_camera(160, 120);
+  const Image full_solid = renderer().render(solid_only, camera), full_scene = renderer().render(scene, camera);
+  renderer().set_quality(SurfaceRenderer::Quality::Fast);
+  const Image fast_solid = renderer().render(solid_only, camera), fast_scene = renderer().render(scene, camera);
+  renderer().set_quality(SurfaceRenderer::Quality::Full);
+  EXPECT_EQ(full_solid.rgba, fast_solid.rgba);
+  int changed = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) changed += differs(full_scene, fast_scene, x, y, 2);
+  EXPECT_GT(changed, 50) << "the water block and the ice sphere show the slab behind them in full quality";
+  EXPECT_GT(psnr(full_scene, fast_scene), 20.0) << "and nothing else changes much";
+}
+
 TEST_F(RenderTest, StageTimes) {
   const DensityFields f = scene_fields(128, true);
   std::printf("[ info ] golden scene in a %dx%dx%d field\n", f.grid.nx, f.grid.ny, f.grid.nz);
