@@ -7,19 +7,7 @@
 
 namespace thaw {
 
-Rgb phase_rgb(std::uint8_t phase) {
-  switch (static_cast<Phase>(phase)) {
-    case Phase::Water:
-      return {40, 110, 230};
-    case Phase::Ice:
-      return {190, 235, 255};
-    case Phase::Solid:
-      return {150, 150, 150};
-    case Phase::Air:
-      return {255, 255, 255};
-  }
-  return {255, 0, 255};
-}
+Rgb phase_rgb(std::uint8_t phase) { return phase_colour(phase); }
 
 Rgb cool_warm(double t) {
   // Moreland, "Diverging Color Maps for Scientific Visualization" (2009), cool-warm at t = 0, 1/8, ..., 1.

@@ -9,6 +9,8 @@
 #include <cstring>
 #include <unordered_map>
 
+#include "sim/little_endian.h"
+
 namespace thaw {
 namespace {
 
@@ -113,15 +115,6 @@ Eigen::Vector3f gradient(const FieldGrid& g, const std::vector<float>& v, int i,
   return {diff(std::max(i - 1, 0), j, k, std::min(i + 1, g.nx - 1), j, k),
           diff(i, std::max(j - 1, 0), k, i, std::min(j + 1, g.ny - 1), k),
           diff(i, j, std::max(k - 1, 0), i, j, std::min(k + 1, g.nz - 1))};
-}
-
-// Our formats are declared little-endian; values go through memory so their exact bits reach the file.
-template <typename T>
-void put(std::string& out, const T& v) {
-  char bytes[sizeof(T)];
-  std::memcpy(bytes, &v, sizeof(T));
-  if constexpr (std::endian::native != std::endian::little) std::reverse(bytes, bytes + sizeof(T));
-  out.append(bytes, sizeof(T));
 }
 
 // Shortest text that reads back as the same float.
@@ -288,12 +281,12 @@ std::string mesh_ply(const Mesh& m) {
       "end_header\n";
   out.reserve(out.size() + 24 * m.vertices.size() + 13 * m.triangles.size());
   for (std::size_t v = 0; v < m.vertices.size(); ++v) {
-    for (int c = 0; c < 3; ++c) put(out, m.vertices[v][c]);
-    for (int c = 0; c < 3; ++c) put(out, m.normals[v][c]);
+    for (int c = 0; c < 3; ++c) put_little_endian(out, m.vertices[v][c]);
+    for (int c = 0; c < 3; ++c) put_little_endian(out, m.normals[v][c]);
   }
   for (const Eigen::Vector3i& t : m.triangles) {
-    put(out, std::uint8_t{3});
-    for (int c = 0; c < 3; ++c) put(out, std::int32_t{t[c]});
+    put_little_endian(out, std::uint8_t{3});
+    for (int c = 0; c < 3; ++c) put_little_endian(out, std::int32_t{t[c]});
   }
   return out;
 }

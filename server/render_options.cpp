@@ -3,10 +3,35 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "sim/error.h"
 
 namespace thaw {
+
+namespace {
+
+// Comma-separated finite numbers, at most `most` of them; an Error quoting `expected` otherwise.
+std::vector<double> numbers(const std::string& option, const std::string& text, std::size_t most,
+                            const std::string& expected) {
+  std::vector<double> out;
+  std::istringstream in(text);
+  for (std::string part; std::getline(in, part, ',');) {
+    std::size_t used = 0;
+    double d = 0;
+    try {
+      d = std::stod(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != part.size() || !std::isfinite(d) || out.size() >= most)
+      throw Error(option + ": expected " + expected + ", got '" + text + "'");
+    out.push_back(d);
+  }
+  return out;
+}
+
+}  // namespace
 
 RenderOptions render_options(const CliArgs& args) {
   RenderOptions o;
@@ -53,45 +78,20 @@ RenderOptions render_options(const CliArgs& args) {
     o.height = h;
   }
   if (auto v = args.value("--camera")) {
-    std::istringstream in(*v);
-    double values[3] = {0, 0, 0};
-    int n = 0;
-    for (std::string part; n < 4 && std::getline(in, part, ',');) {
-      std::size_t used = 0;
-      double d = 0;
-      try {
-        d = std::stod(part, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != part.size() || !std::isfinite(d) || n >= 3)
-        throw Error("--camera: expected AZIMUTH,ELEVATION[,DISTANCE] in degrees and metres, e.g. 30,25 or "
-                    "30,25,0.4, got '" + *v + "'");
-      values[n++] = d;
-    }
-    if (n < 2) throw Error("--camera: expected AZIMUTH,ELEVATION[,DISTANCE], got '" + *v + "'");
-    if (std::abs(values[1]) >= 90.0) throw Error("--camera: elevation must be between -90 and 90 degrees");
-    if (n == 3 && values[2] <= 0) throw Error("--camera: distance must be positive");
-    o.azimuth = values[0];
-    o.elevation = values[1];
-    if (n == 3) o.distance = values[2];
+    const std::string expected = "AZIMUTH,ELEVATION[,DISTANCE] in degrees and metres, e.g. 30,25 or 30,25,0.4";
+    const std::vector<double> c = numbers("--camera", *v, 3, expected);
+    if (c.size() < 2) throw Error("--camera: expected " + expected + ", got '" + *v + "'");
+    if (std::abs(c[1]) >= 90.0) throw Error("--camera: elevation must be between -90 and 90 degrees");
+    if (c.size() == 3 && c[2] <= 0) throw Error("--camera: distance must be positive");
+    o.azimuth = c[0];
+    o.elevation = c[1];
+    if (c.size() == 3) o.distance = c[2];
   }
   if (auto v = args.value("--target")) {
-    std::istringstream in(*v);
-    int n = 0;
-    for (std::string part; std::getline(in, part, ',');) {
-      std::size_t used = 0;
-      double d = 0;
-      try {
-        d = std::stod(part, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != part.size() || !std::isfinite(d) || n >= 3)
-        throw Error("--target: expected X,Y,Z in metres, e.g. 0.05,0.05,0.02, got '" + *v + "'");
-      o.target[n++] = d;
-    }
-    if (n != 3) throw Error("--target: expected X,Y,Z in metres, got '" + *v + "'");
+    const std::string expected = "X,Y,Z in metres, e.g. 0.05,0.05,0.02";
+    const std::vector<double> t = numbers("--target", *v, 3, expected);
+    if (t.size() != 3) throw Error("--target: expected " + expected + ", got '" + *v + "'");
+    o.target = {t[0], t[1], t[2]};
     o.has_target = true;
   }
   if (auto v = args.value("--fov")) {

@@ -12,20 +12,12 @@
 #include <system_error>
 
 #include "sim/error.h"
+#include "sim/little_endian.h"
 #include "sim/state_file.h"
 
 namespace thaw {
 namespace {
 
-// Both formats are declared little-endian. On little-endian hosts each value is one small append;
-// floats go through memory so their exact bits (NaN payloads) reach the file.
-template <typename T>
-void put(std::string& out, const T& v) {
-  char bytes[sizeof(T)];
-  std::memcpy(bytes, &v, sizeof(T));
-  if constexpr (std::endian::native != std::endian::little) std::reverse(bytes, bytes + sizeof(T));
-  out.append(bytes, sizeof(T));
-}
 
 // Shortest text that reads back as the same double, so frame times in the .pvd are exact.
 std::string exact(double v) {
@@ -83,13 +75,13 @@ std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::
   mass.bytes.reserve(4 * n);
   id.bytes.reserve(4 * n);
   for (std::size_t i : order) {
-    for (int c = 0; c < 3; ++c) put(velocity.bytes, p.velocity[i][c]);
-    put(speed_array.bytes, speed(p.velocity[i]));
-    put(phase.bytes, p.phase[i]);
-    put(material.bytes, p.material[i]);
-    put(density.bytes, p.density[i]);
-    put(mass.bytes, p.position[i][3]);
-    put(id.bytes, p.id[i]);
+    for (int c = 0; c < 3; ++c) put_little_endian(velocity.bytes, p.velocity[i][c]);
+    put_little_endian(speed_array.bytes, speed(p.velocity[i]));
+    put_little_endian(phase.bytes, p.phase[i]);
+    put_little_endian(material.bytes, p.material[i]);
+    put_little_endian(density.bytes, p.density[i]);
+    put_little_endian(mass.bytes, p.position[i][3]);
+    put_little_endian(id.bytes, p.id[i]);
   }
   std::vector<VtkArray> arrays;
   for (VtkArray* a : {&velocity, &speed_array, &phase, &material, &density, &mass, &id}) {
@@ -98,7 +90,7 @@ std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::
   if (!temperature.empty()) {
     VtkArray t{"temperature", "Float32", 1, {}};
     t.bytes.reserve(4 * n);
-    for (std::size_t i : order) put(t.bytes, temperature[i]);
+    for (std::size_t i : order) put_little_endian(t.bytes, temperature[i]);
     arrays.push_back(std::move(t));
   }
   return arrays;
@@ -120,7 +112,7 @@ std::string vtu_file(const HostParticles& p, const std::vector<std::size_t>& ord
   VtkArray points{"position", "Float32", 3, {}};
   points.bytes.reserve(12 * n);
   for (std::size_t i : order) {
-    for (int c = 0; c < 3; ++c) put(points.bytes, p.position[i][c]);
+    for (int c = 0; c < 3; ++c) put_little_endian(points.bytes, p.position[i][c]);
   }
   constexpr std::uint8_t kVtkVertex = 1;
   VtkArray connectivity{"connectivity", "Int64", 1, {}}, offsets{"offsets", "Int64", 1, {}};
@@ -128,8 +120,8 @@ std::string vtu_file(const HostParticles& p, const std::vector<std::size_t>& ord
   connectivity.bytes.reserve(8 * n);
   offsets.bytes.reserve(8 * n);
   for (std::size_t k = 0; k < n; ++k) {
-    put(connectivity.bytes, static_cast<std::int64_t>(k));
-    put(offsets.bytes, static_cast<std::int64_t>(k + 1));
+    put_little_endian(connectivity.bytes, static_cast<std::int64_t>(k));
+    put_little_endian(offsets.bytes, static_cast<std::int64_t>(k + 1));
   }
 
   std::vector<const VtkArray*> blocks;
@@ -171,7 +163,7 @@ std::string vtu_file(const HostParticles& p, const std::vector<std::size_t>& ord
       "   _";
   xml.reserve(xml.size() + offset + 64);
   for (const VtkArray* a : blocks) {
-    put(xml, static_cast<std::uint64_t>(a->bytes.size()));
+    put_little_endian(xml, static_cast<std::uint64_t>(a->bytes.size()));
     xml += a->bytes;
   }
   xml +=
@@ -179,21 +171,6 @@ std::string vtu_file(const HostParticles& p, const std::vector<std::size_t>& ord
       "  </AppendedData>\n"
       "</VTKFile>\n";
   return xml;
-}
-
-// Blender's PLY importer reads per-vertex colour from uchar red/green/blue; phase picks the colour.
-std::array<std::uint8_t, 3> phase_colour(std::uint8_t phase) {
-  switch (static_cast<Phase>(phase)) {
-    case Phase::Water:
-      return {40, 110, 230};
-    case Phase::Ice:
-      return {200, 240, 255};
-    case Phase::Solid:
-      return {128, 128, 128};
-    case Phase::Air:
-      return {255, 255, 255};
-  }
-  return {255, 0, 255};  // a phase byte out of range stands out instead of passing as a real phase
 }
 
 // Vertex record, 32 bytes: x y z vx vy vz density (float), phase red green blue (uchar); 36 with a
@@ -225,12 +202,12 @@ std::string ply_file(const HostParticles& p, const std::vector<std::size_t>& ord
       "end_header\n";
   out.reserve(out.size() + 32 * order.size());
   for (std::size_t i : order) {
-    for (int c = 0; c < 3; ++c) put(out, p.position[i][c]);
-    for (int c = 0; c < 3; ++c) put(out, p.velocity[i][c]);
-    put(out, p.density[i]);
-    if (with_t) put(out, temperature[i]);
-    put(out, p.phase[i]);
-    for (std::uint8_t c : phase_colour(p.phase[i])) put(out, c);
+    for (int c = 0; c < 3; ++c) put_little_endian(out, p.position[i][c]);
+    for (int c = 0; c < 3; ++c) put_little_endian(out, p.velocity[i][c]);
+    put_little_endian(out, p.density[i]);
+    if (with_t) put_little_endian(out, temperature[i]);
+    put_little_endian(out, p.phase[i]);
+    for (std::uint8_t c : phase_colour(p.phase[i])) put_little_endian(out, c);
   }
   return out;
 }

@@ -14,6 +14,16 @@ const char* phase_name(Phase p) {
   return "unknown";
 }
 
+std::array<std::uint8_t, 3> phase_colour(std::uint8_t phase) {
+  switch (static_cast<Phase>(phase)) {
+    case Phase::Water: return {40, 110, 230};
+    case Phase::Ice: return {200, 240, 255};
+    case Phase::Solid: return {150, 150, 150};
+    case Phase::Air: return {255, 255, 255};
+  }
+  return {255, 0, 255};
+}
+
 void HostParticles::resize(std::size_t n) {
   position.resize(n);
   velocity.resize(n);

@@ -10,6 +10,10 @@ enum class Phase : std::uint8_t { Water = 0, Ice = 1, Solid = 2, Air = 3 };
 inline constexpr int kPhaseCount = 4;
 const char* phase_name(Phase p);
 
+// The colour each phase is shown in (RGB): the PLY export's vertex colours (Blender reads them) and the
+// renderer's particle view. A phase byte out of range is magenta, so it stands out.
+std::array<std::uint8_t, 3> phase_colour(std::uint8_t phase);
+
 using Float4 = std::array<float, 4>;  // layout-compatible with cl_float4
 using Float2 = std::array<float, 2>;  // layout-compatible with cl_float2
 

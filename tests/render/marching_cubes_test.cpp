@@ -12,6 +12,7 @@
 
 #include "render/mesh_export.h"
 #include "sim/error.h"
+#include "tests/render/lattice_snapshot.h"
 #include "tests/test_support.h"
 
 namespace thaw {
@@ -20,29 +21,11 @@ namespace {
 constexpr float kSpacing = 0.01f;
 const Eigen::Vector3f kCentre(-0.05f, 0.12f, 0.2f);
 
-void add(RenderSnapshot& s, const Eigen::Vector3f& x, Phase phase) {
-  s.position.push_back(x);
-  s.phase.push_back(std::uint8_t(phase));
-}
-
-// Lattice points within `radius` spacings of kCentre, cell-centred like the scene sampler's lattice.
 void add_sphere(RenderSnapshot& s, float radius, Phase phase) {
-  const int n = int(std::ceil(radius));
-  for (int k = -n; k < n; ++k)
-    for (int j = -n; j < n; ++j)
-      for (int i = -n; i < n; ++i) {
-        const Eigen::Vector3f x =
-            Eigen::Vector3f(float(i), float(j), float(k)) + Eigen::Vector3f::Constant(0.5f);
-        if (x.norm() < radius) add(s, kCentre + kSpacing * x, phase);
-      }
+  testing::add_lattice_sphere(s, kCentre, kSpacing, radius, phase);
 }
-
-// nx * ny * nz lattice points from `corner`: a box of (nx, ny, nz) spacings around them.
 void add_box(RenderSnapshot& s, const Eigen::Vector3f& corner, int nx, int ny, int nz, Phase phase) {
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        add(s, corner + kSpacing * Eigen::Vector3f(float(i), float(j), float(k)), phase);
+  testing::add_lattice_box(s, corner, kSpacing, nx, ny, nz, phase);
 }
 
 RenderSnapshot snapshot() {
