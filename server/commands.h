@@ -7,4 +7,5 @@ int cmd_bench(int argc, char** argv);
 int cmd_info(int argc, char** argv);
 int cmd_scene_doc(int argc, char** argv);
 int cmd_render(int argc, char** argv);
+int cmd_serve(int argc, char** argv);
 }  // namespace thaw

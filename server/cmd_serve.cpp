@@ -1,0 +1,78 @@
+// `thaw serve [SCENE]`: the live service. One port: HTTP for web/ and the thaw.v1 WebSocket protocol.
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <thread>
+
+#include "server/cli_args.h"
+#include "server/commands.h"
+#include "server/render_worker.h"
+#include "server/service.h"
+#include "server/session.h"
+#include "server/ws_server.h"
+#include "sim/error.h"
+
+namespace thaw {
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+}  // namespace
+
+int cmd_serve(int argc, char** argv) {
+  CliArgs args(argc, argv, 2, {"--host", "--port", "--token", "--state-dir", "--state-out", "--device", "--web"},
+               {"--quiet"});
+  if (args.positional().size() > 1) throw Error("serve takes at most one scene");
+  const std::string scene = args.positional().empty() ? "default" : args.positional()[0];
+  ServerOptions net;
+  net.host = args.value("--host").value_or("127.0.0.1");
+  const long long port = args.integer("--port", 8080);
+  if (port < 0 || port > 65535) throw Error("--port: expected 0..65535 (0: any free port)");
+  net.port = static_cast<int>(port);
+  net.web_root = args.value("--web").value_or(std::string(THAW_SOURCE_DIR) + "/web");
+  ServiceOptions service_options;
+  service_options.token = args.value("--token").value_or("");
+  service_options.loopback = net.host == "127.0.0.1" || net.host == "localhost";
+  // Anyone who can reach a non-loopback address could steer the simulation: require a token there.
+  if (!service_options.loopback && service_options.token.empty())
+    throw Error("--host " + net.host + ": serving beyond 127.0.0.1 needs --token TOKEN (clients without it watch)");
+
+  ClRuntime cl(args.value("--device").value_or(""));
+  Session session(cl, scene, args.sets(), args.value("--state-dir").value_or("thaw-states"));
+  std::atomic<Service*> service_ptr{nullptr};
+  RenderWorker renderer(session, RenderOptions{}, [&] {
+    if (Service* s = service_ptr.load()) s->frame_ready();
+  });
+  Service service(session, renderer, service_options);
+  WsServer server(net, service);
+  service.attach(server);
+  service_ptr = &service;
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  session.start();
+  renderer.start();
+  // The signal handler only sets a flag; this thread turns it into a wake-up of the loop.
+  std::thread watcher([&] {
+    while (!g_stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    server.request_stop();
+  });
+  if (!args.flag("--quiet")) {
+    std::printf("thaw serve: scene '%s' on http://%s:%d/ (WebSocket subprotocol %s)%s\n", scene.c_str(),
+                net.host.c_str(), server.port(), protocol::kSubprotocol,
+                service_options.token.empty() ? "" : "; controller token required");
+    std::fflush(stdout);
+  }
+  server.run();
+  g_stop = true;
+  watcher.join();
+  renderer.stop();
+  service_ptr = nullptr;
+  if (auto out = args.value("--state-out")) session.save_state(*out);
+  session.stop();
+  if (!args.flag("--quiet")) std::printf("thaw serve: stopped\n");
+  return 0;
+}
+
+}  // namespace thaw

@@ -1,0 +1,128 @@
+#pragma once
+// The render thread of `thaw serve` (DESIGN.md, Server): it owns the EGL context (created on this thread,
+// the only one that may use it), renders the session's newest snapshot in the current view, encodes it
+// to JPEG once for every viewer and publishes the newest frame; the network loop takes it from there.
+// Frames are never queued: a snapshot that arrives while a frame is being rendered replaces any older
+// one waiting, so the worker always draws the latest state and falls behind by at most one frame.
+//
+// One set of view options serves every viewer, because a frame is encoded once for all. Per-client
+// cameras would need a render (and an encode) per client, i.e. per-client RenderOptions here and a
+// frame per camera; the cost on llvmpipe (~100 ms a surface frame) is why that waits.
+#include <Eigen/Core>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "render/camera.h"
+#include "render/density_field.h"
+#include "render/snapshot.h"
+#include "server/render_options.h"
+
+namespace thaw {
+
+class Session;
+
+// One encoded frame, shared by every client that sends it.
+struct EncodedFrame {
+  std::uint64_t frame = 0;  // 1, 2, ... in the order rendered
+  double sim_time = 0;      // [s] of the snapshot drawn
+  std::uint64_t step = 0;   // of the snapshot drawn
+  int width = 0, height = 0;
+  std::string jpeg;
+  double render_ms = 0;  // drawing, read-back included
+  double encode_ms = 0;
+};
+
+class RenderWorker {
+ public:
+  // `on_frame` runs on the render thread after each new frame (e.g. lws_cancel_service); keep it quick.
+  // `session` must outlive the worker (the worker subscribes to its publishes until stop()).
+  RenderWorker(Session& session, RenderOptions options = {}, std::function<void()> on_frame = {});
+  ~RenderWorker();  // stops
+  RenderWorker(const RenderWorker&) = delete;
+  RenderWorker& operator=(const RenderWorker&) = delete;
+
+  void start();
+  void stop();
+
+  // ---- view settings (thread-safe; the next frame uses them) ------------------------------------------
+  // Absent values keep theirs. Throws Error on a value out of range (elevation in (-90, 90), distance
+  // > 0, fov in [5, 120]), changing nothing.
+  void set_camera(std::optional<double> azimuth, std::optional<double> elevation,
+                  std::optional<double> distance, std::optional<Eigen::Vector3d> target,
+                  std::optional<double> fov);
+  // Relative: degrees added to azimuth and elevation (clamped to +-89), distance multiplied by zoom.
+  void orbit(double d_azimuth, double d_elevation, double zoom);
+  // view: surface | particles | slice; colour_by: phase | temperature.
+  void set_view(const std::string& view, std::optional<std::string> colour_by = {});
+  // width 16..1920, height 16..1080, jpeg_quality 10..95, fps cap 1..60, surface full | fast.
+  void set_quality(std::optional<int> width, std::optional<int> height, std::optional<int> jpeg_quality,
+                   std::optional<double> fps, std::optional<std::string> surface);
+  RenderOptions options() const;
+  int jpeg_quality() const;
+  double fps_cap() const;
+
+  // ---- what the worker publishes (thread-safe) -----------------------------------------------------
+  std::shared_ptr<const EncodedFrame> latest_frame() const;
+  // Waits until a frame numbered above `after` exists or `timeout` passes; returns the newest (or null).
+  std::shared_ptr<const EncodedFrame> wait_for_frame(std::uint64_t after,
+                                                     std::chrono::milliseconds timeout) const;
+  // "starting", "ok: <renderer>", or "error: <what failed>" (e.g. no EGL): without a renderer the worker
+  // keeps running, just without frames, and says why here.
+  std::string status() const;
+
+  // The surface point under pixel (x, y) of the last frame (pixels from the top left), with its outward
+  // normal; nothing when the ray misses, before the first frame, or in the slice view (it has no camera).
+  // Runs on the calling thread on the last frame's fields, built here when the view did not need them.
+  struct Pick {
+    Eigen::Vector3d hit, normal;
+  };
+  std::optional<Pick> pick(double x, double y) const;
+
+ private:
+  void run();
+  bool render_one(const std::shared_ptr<const RenderSnapshot>& snapshot, const RenderOptions& options,
+                  int jpeg_quality);
+  void set_status(std::string s);
+
+  Session& session_;
+  std::function<void()> on_frame_;
+  int listener_ = 0;
+
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  RenderOptions options_;
+  int jpeg_quality_ = 80;
+  double fps_ = 30.0;
+  std::uint64_t options_version_ = 1;
+  bool snapshot_pending_ = true;  // the session published since the last frame began
+  bool stop_ = false;
+  std::thread thread_;
+  std::string status_ = "starting";
+
+  // Published frame, and what pick() needs of it.
+  mutable std::mutex frame_mutex_;
+  mutable std::condition_variable frame_cv_;
+  std::shared_ptr<const EncodedFrame> frame_;
+  std::shared_ptr<const RenderSnapshot> picked_snapshot_;
+  mutable std::shared_ptr<const DensityFields> picked_fields_;  // built lazily by pick() in other views
+  OrbitCamera picked_camera_;
+  FieldOptions picked_field_options_;
+  bool pick_has_camera_ = false;
+
+  // Render-thread only: the GL objects and what was last uploaded.
+  struct Gl;
+  std::unique_ptr<Gl> gl_;
+  bool gl_failed_ = false;
+  std::shared_ptr<const RenderSnapshot> uploaded_;
+  FieldOptions uploaded_field_options_;
+  std::uint64_t frames_ = 0;
+};
+
+}  // namespace thaw

@@ -1,0 +1,211 @@
+#include "server/service.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+
+#include "sim/scene.h"
+
+namespace thaw {
+namespace {
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Scene names a client may load: the files of configs/.
+Json scene_names() {
+  Json names = Json::array();
+  std::error_code ec;
+  std::vector<std::string> found;
+  for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(THAW_SOURCE_DIR) / "configs", ec))
+    if (e.path().extension() == ".json") found.push_back(e.path().stem().string());
+  std::sort(found.begin(), found.end());
+  for (const auto& n : found) names.push_back(n);
+  return names;
+}
+
+Json vec(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json dryers_json(const Scene& s) {
+  Json out = Json::array();
+  for (const Dryer& d : s.dryers)
+    out.push_back({{"on", d.on},
+                   {"position", vec(d.position)},
+                   {"direction", vec(d.direction)},
+                   {"temperature", d.temperature},
+                   {"speed", d.speed},
+                   {"half_angle", d.half_angle},
+                   {"reach", d.reach}});
+  return out;
+}
+
+}  // namespace
+
+Service::Service(Session& session, RenderWorker& renderer, ServiceOptions options)
+    : session_(session), renderer_(renderer), options_(std::move(options)) {
+  subscription_ = session_.subscribe([this] { on_published(); });
+}
+
+Service::~Service() { session_.unsubscribe(subscription_); }
+
+void Service::attach(WsServer& server) { server_ = &server; }
+
+Json Service::welcome(bool controller) const {
+  const auto scene = session_.scene();
+  Json lamps = Json::array();
+  for (const Lamp& l : scene->lamps)
+    lamps.push_back({{"on", l.on}, {"centre", vec(l.centre)}, {"normal", vec(l.normal)}, {"temperature", l.temperature}});
+  return {{"type", "welcome"},
+          {"protocol", protocol::kVersion},
+          {"scene", scene->name},
+          {"scenes", scene_names()},
+          {"dryers", dryers_json(*scene)},
+          {"lamps", lamps},
+          {"role", controller ? "controller" : "viewer"},
+          {"views", {"surface", "particles", "slice"}},
+          {"limits",
+           {{"max_message_bytes", protocol::kMaxMessageBytes},
+            {"commands_per_second", options_.command_rate},
+            {"command_burst", options_.command_burst},
+            {"unacknowledged_frames", 2}}}};
+}
+
+void Service::reply(std::uint64_t client, const Json& event) {
+  if (server_) server_->send_text(client, event.dump());
+}
+
+void Service::on_open(std::uint64_t client, const std::string&) {
+  std::lock_guard lock(mutex_);
+  // Without a token, a server that only loopback clients can reach gives everyone control.
+  clients_.emplace(client, Client{options_.token.empty() && options_.loopback,
+                                  protocol::RateLimiter(options_.command_rate, options_.command_burst)});
+}
+
+void Service::on_close(std::uint64_t client) {
+  std::lock_guard lock(mutex_);
+  clients_.erase(client);
+}
+
+void Service::on_oversize(std::uint64_t client, std::size_t bytes) {
+  reply(client, protocol::error(protocol::ErrorCode::TooLarge,
+                                "message of " + std::to_string(bytes) + " bytes; the limit is " +
+                                    std::to_string(protocol::kMaxMessageBytes)));
+}
+
+void Service::on_text(std::uint64_t client, std::string_view message) {
+  using namespace protocol;
+  bool controller = false;
+  {
+    std::lock_guard lock(mutex_);
+    const auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    if (!it->second.limiter.allow(now_s())) {
+      reply(client, error(ErrorCode::RateLimited, "more than " + std::to_string(int(options_.command_rate)) +
+                                                      " commands a second; slow down"));
+      return;
+    }
+    controller = it->second.controller;
+  }
+  const auto parsed = parse(message);
+  if (const auto* e = std::get_if<ParseError>(&parsed)) {
+    reply(client, error(e->code, e->message, e->id, e->type));
+    return;
+  }
+  const Request& r = std::get<Request>(parsed);
+  const std::string type = type_name(r.command);
+  if (const auto* hello = std::get_if<Hello>(&r.command)) {
+    if (hello->token && !options_.token.empty() && *hello->token == options_.token) {
+      std::lock_guard lock(mutex_);
+      const auto it = clients_.find(client);
+      if (it != clients_.end()) it->second.controller = controller = true;
+    } else if (hello->token && !options_.token.empty()) {
+      reply(client, error(ErrorCode::Forbidden, "hello: wrong token; connected as a viewer", r.id, type));
+    }
+    reply(client, welcome(controller));
+    return;
+  }
+  if (needs_controller(r.command) && !controller) {
+    reply(client, error(ErrorCode::Forbidden, type + ": needs the controller role (hello with the server's token)",
+                        r.id, type));
+    return;
+  }
+  const auto id = r.id;
+  auto done = [this, client, id, type](std::optional<ErrorCode> code, std::string msg, Json result) {
+    if (code) {
+      reply(client, error(*code, msg, id, type));
+    } else {
+      Json a = ack(id, type);
+      if (result.is_object())
+        for (const auto& [k, v] : result.items()) a[k] = v;
+      reply(client, a);
+    }
+  };
+  std::visit(
+      [&](const auto& c) {
+        using T = std::decay_t<decltype(c)>;
+        if constexpr (std::is_same_v<T, FrameAck>) {
+          if (server_) server_->ack_frame(client, c.frame);
+        } else if constexpr (std::is_same_v<T, CameraSet>) {
+          renderer_.set_camera(c.azimuth, c.elevation, c.distance, c.target, c.fov);
+          done({}, "", Json::object());
+        } else if constexpr (std::is_same_v<T, CameraOrbit>) {
+          renderer_.orbit(c.d_azimuth, c.d_elevation, c.zoom);
+          done({}, "", Json::object());
+        } else if constexpr (std::is_same_v<T, ViewSet>) {
+          renderer_.set_view(c.view, c.colour_by);
+          done({}, "", Json::object());
+        } else if constexpr (std::is_same_v<T, QualitySet>) {
+          renderer_.set_quality(c.width, c.height, c.jpeg_quality, c.fps, c.surface);
+          done({}, "", Json::object());
+        } else if constexpr (std::is_same_v<T, DryerAim>) {
+          const auto hit = renderer_.pick(c.x, c.y);
+          if (!hit)
+            done(ErrorCode::NotFound, type + ": no surface under pixel (" + std::to_string(c.x) + ", " +
+                                          std::to_string(c.y) + ")",
+                 Json::object());
+          else
+            session_.aim_dryer(c.dryer, hit->hit, done);
+        } else {
+          session_.submit(r.command, done);
+        }
+      },
+      r.command);
+}
+
+void Service::on_published() {
+  // Stats at most stats_rate a second: a browser needs no more, and they share the socket with frames.
+  {
+    std::lock_guard lock(mutex_);
+    const double t = now_s();
+    if (last_stats_ >= 0 && t - last_stats_ < 1.0 / options_.stats_rate) return;
+    last_stats_ = t;
+  }
+  const auto stats = session_.latest_stats();
+  if (!stats || !server_) return;
+  Json s = *stats;
+  if (const auto f = renderer_.latest_frame()) {
+    s["frame"] = f->frame;
+    s["render_ms"] = f->render_ms;
+    s["encode_ms"] = f->encode_ms;
+  }
+  s["dryers"] = dryers_json(*session_.scene());
+  server_->broadcast_text(s.dump());
+}
+
+void Service::frame_ready() {
+  const auto f = renderer_.latest_frame();
+  if (!f || !server_) return;
+  {
+    std::lock_guard lock(mutex_);
+    if (f->frame <= last_frame_sent_) return;
+    last_frame_sent_ = f->frame;
+  }
+  auto bytes = std::make_shared<std::string>(protocol::frame_header(
+      f->frame, f->sim_time, static_cast<std::uint16_t>(f->width), static_cast<std::uint16_t>(f->height),
+      static_cast<std::uint32_t>(f->jpeg.size())));
+  bytes->append(f->jpeg);
+  server_->publish_frame(std::move(bytes), f->frame);
+}
+
+}  // namespace thaw

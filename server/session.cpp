@@ -1,0 +1,683 @@
+#include "server/session.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <future>
+
+#include "sim/error.h"
+#include "sim/metrics.h"
+#include "sim/solver.h"
+#include "sim/state_file.h"
+#include "sim/thermal.h"
+
+namespace thaw {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using protocol::ErrorCode;
+
+namespace {
+
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json dryer_json(const Dryer& d) {
+  return {{"on", d.on},
+          {"position", vec_json(d.position)},
+          {"direction", vec_json(d.direction)},
+          {"half_angle", d.half_angle},
+          {"reach", d.reach},
+          {"temperature", d.temperature},
+          {"speed", d.speed},
+          {"nozzle_diameter", d.nozzle_diameter}};
+}
+
+Json lamp_json(const Lamp& l) {
+  return {{"on", l.on},
+          {"centre", vec_json(l.centre)},
+          {"normal", vec_json(l.normal)},
+          {"width", l.width},
+          {"height", l.height},
+          {"temperature", l.temperature},
+          {"emissivity", l.emissivity},
+          {"photons", l.photons}};
+}
+
+// State names become file names in the state folder: nothing that could leave it (DESIGN.md: the
+// protocol checks this too; the session does not rely on its caller for what touches the disk).
+bool valid_state_name(const std::string& name) {
+  if (name.empty() || name.size() > 64) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  });
+}
+
+// Completions run on the simulation thread; one that throws must not take the thread down with it.
+void answer(const Session::Done& done, std::optional<ErrorCode> code, const std::string& message,
+            const Json& result) {
+  if (!done) return;
+  try {
+    done(code, message, result);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "thaw serve: a command's completion failed: %s\n", e.what());
+  }
+}
+
+double ice_mass_of(const HostParticles& p, const Scene& scene, double rest_density) {
+  return measure(p, scene, rest_density).ice_mass;
+}
+
+}  // namespace
+
+Session::Session(ClRuntime& cl, std::string scene_name, std::vector<std::string> overrides,
+                 std::string state_dir)
+    : cl_(cl), overrides_(std::move(overrides)), state_dir_(std::move(state_dir)) {
+  std::error_code ec;
+  fs::create_directories(state_dir_, ec);
+  if (ec) throw Error("cannot create the state folder '" + state_dir_ + "': " + ec.message());
+  Scene scene = load_scene(scene_name, overrides_);
+  const SimState start = initial_state(scene);
+  rebuild(std::move(scene), start, true);
+  last_publish_ = Clock::now();
+  publish();
+}
+
+Session::~Session() { stop(); }
+
+void Session::start() {
+  std::lock_guard lock(queue_mutex_);
+  if (thread_.joinable() || stop_) return;
+  thread_running_ = true;
+  thread_ = std::thread(&Session::run, this);
+}
+
+void Session::stop() {
+  std::deque<Pending> never_run;
+  {
+    std::lock_guard lock(queue_mutex_);
+    stop_ = true;
+    // Without a thread nothing would ever answer what was queued before start().
+    if (!thread_.joinable()) never_run.swap(queue_);
+  }
+  queue_cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  for (Pending& p : never_run) {
+    if (auto* task = std::get_if<Task>(&p.what))
+      (*task)();
+    else
+      answer(p.done, ErrorCode::Failed, "the simulation has stopped", Json::object());
+  }
+}
+
+void Session::submit(protocol::Command command, Done done) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (!(stop_ && !thread_running_)) {
+      queue_.push_back({std::move(command), std::move(done)});
+      done = nullptr;
+    }
+  }
+  queue_cv_.notify_all();
+  if (done) done(ErrorCode::Failed, "the simulation has stopped", Json::object());
+}
+
+void Session::aim_dryer(int dryer, const Eigen::Vector3d& hit, Done done) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    if (!(stop_ && !thread_running_)) {
+      queue_.push_back({Aim{dryer, hit}, std::move(done)});
+      done = nullptr;
+    }
+  }
+  queue_cv_.notify_all();
+  if (done) done(ErrorCode::Failed, "the simulation has stopped", Json::object());
+}
+
+void Session::save_state(const std::string& path) {
+  auto write = [this, path] {
+    SimState st = solver_->state();
+    st.scene_json = scene_.source.dump();  // with the live dryer and lamp changes
+    write_state_file(path, st);
+  };
+  std::unique_lock lock(queue_mutex_);
+  if (!thread_running_) {
+    lock.unlock();
+    write();
+    return;
+  }
+  auto promise = std::make_shared<std::promise<void>>();
+  std::future<void> written = promise->get_future();
+  queue_.push_back({Task([write, promise] {
+                      try {
+                        write();
+                        promise->set_value();
+                      } catch (...) {
+                        promise->set_exception(std::current_exception());
+                      }
+                    }),
+                    {}});
+  lock.unlock();
+  queue_cv_.notify_all();
+  written.get();
+}
+
+// ---- published values ---------------------------------------------------------------------------------
+
+std::shared_ptr<const RenderSnapshot> Session::latest_snapshot() const {
+  std::lock_guard lock(publish_mutex_);
+  return snapshot_;
+}
+
+std::shared_ptr<const Json> Session::latest_stats() const {
+  std::lock_guard lock(publish_mutex_);
+  return stats_;
+}
+
+std::shared_ptr<const Scene> Session::scene() const {
+  std::lock_guard lock(publish_mutex_);
+  return scene_published_;
+}
+
+std::uint64_t Session::sequence() const {
+  std::lock_guard lock(publish_mutex_);
+  return sequence_;
+}
+
+std::uint64_t Session::wait_for_sequence(std::uint64_t after, std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(publish_mutex_);
+  publish_cv_.wait_for(lock, timeout, [&] { return sequence_ > after; });
+  return sequence_;
+}
+
+int Session::subscribe(std::function<void()> on_publish) {
+  std::lock_guard lock(listeners_mutex_);
+  listeners_.emplace_back(next_listener_, std::move(on_publish));
+  return next_listener_++;
+}
+
+void Session::unsubscribe(int id) {
+  std::lock_guard lock(listeners_mutex_);
+  std::erase_if(listeners_, [id](const auto& l) { return l.first == id; });
+}
+
+// ---- the simulation thread -----------------------------------------------------------------------------
+
+void Session::run() {
+  reanchor();
+  last_publish_ = Clock::now();
+  window_start_steps_ = solver_->steps();
+  for (;;) {
+    std::deque<Pending> batch;
+    {
+      std::lock_guard lock(queue_mutex_);
+      if (stop_) break;
+      batch.swap(queue_);
+    }
+    if (!batch.empty()) apply_pending(batch);
+
+    // sim.step requests go first and ignore both pause and speed: the user asked for those steps now.
+    if (!step_requests_.empty()) {
+      step_once();
+      if (step_requests_.empty()) continue;  // the step failed and answered them
+      if (--step_requests_.front().remaining > 0) {
+        maybe_publish();
+        continue;
+      }
+      StepRequest finished = std::move(step_requests_.front());
+      step_requests_.pop_front();
+      publish();
+      answer(finished.done, std::nullopt, "", time_result());
+      continue;
+    }
+
+    if (running_) {
+      if (speed_ > 0) {
+        // Never run ahead of wall time * factor; when behind by more than a moment, start counting afresh
+        // rather than sprint to catch up.
+        const auto due =
+            anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
+                               std::chrono::duration<double>((solver_->time() - anchor_sim_) / speed_));
+        const auto now = Clock::now();
+        if (now < due) {
+          if (dirty_) maybe_publish();
+          wait_for_work(std::min(due, now + std::chrono::milliseconds(100)));
+          continue;
+        }
+        if (now - due > std::chrono::milliseconds(100)) reanchor();
+      }
+      step_once();
+      maybe_publish();
+      continue;
+    }
+
+    if (dirty_) publish();
+    wait_for_work(std::nullopt);
+  }
+
+  // Stopping: run what save_state() queued (a caller waits on it); the commands only learn they failed.
+  // thread_running_ drops only once the queue is empty, so save_state() never runs beside this thread.
+  for (;;) {
+    std::deque<Pending> rest;
+    {
+      std::lock_guard lock(queue_mutex_);
+      if (queue_.empty()) {
+        thread_running_ = false;
+        break;
+      }
+      rest.swap(queue_);
+    }
+    for (Pending& p : rest) {
+      if (auto* task = std::get_if<Task>(&p.what))
+        (*task)();
+      else
+        answer(p.done, ErrorCode::Failed, "the simulation has stopped", Json::object());
+    }
+  }
+  fail_step_requests("the simulation has stopped");
+}
+
+bool Session::wait_for_work(std::optional<Clock::time_point> until) {
+  std::unique_lock lock(queue_mutex_);
+  auto ready = [&] { return stop_ || !queue_.empty(); };
+  if (until) return queue_cv_.wait_until(lock, *until, ready);
+  queue_cv_.wait(lock, ready);
+  return true;
+}
+
+void Session::apply_pending(std::deque<Pending>& batch) {
+  struct Answer {
+    Done done;
+    Outcome outcome;
+  };
+  std::vector<Answer> answers;
+  for (Pending& p : batch) {
+    if (auto* task = std::get_if<Task>(&p.what)) {
+      (*task)();
+      continue;
+    }
+    Outcome o;
+    bool deferred = false;
+    try {
+      if (auto* a = std::get_if<Aim>(&p.what))
+        o = aim(*a);
+      else
+        o = apply(std::get<protocol::Command>(p.what), p.done, deferred);
+    } catch (const std::exception& e) {
+      // Whatever a command throws past its own handling (a device error while rebuilding, say) is
+      // the command's failure, not the service's.
+      o = {ErrorCode::Failed, e.what(), Json::object()};
+    }
+    if (!deferred) answers.push_back({std::move(p.done), std::move(o)});
+  }
+  // Answer after publishing, so a client that sees the ack and then reads the stats sees its change.
+  if (dirty_) publish();
+  for (Answer& a : answers) answer(a.done, a.outcome.code, a.outcome.message, a.outcome.result);
+}
+
+Session::Outcome Session::apply(const protocol::Command& command, Done& done, bool& deferred) {
+  return std::visit(
+      Overloaded{
+          [&](const protocol::DryerSet& c) { return apply(c); },
+          [&](const protocol::LampSet& c) { return apply(c); },
+          [&](const protocol::SceneLoad& c) { return apply(c); },
+          [&](const protocol::ParamSet& c) { return apply(c); },
+          [&](const protocol::StateSave& c) { return apply(c); },
+          [&](const protocol::StateLoad& c) { return apply(c); },
+          [&](const protocol::SimPause&) {
+            running_ = false;
+            paused_by_error_ = false;
+            dirty_ = true;
+            return Outcome{std::nullopt, "", time_result()};
+          },
+          [&](const protocol::SimResume&) {
+            running_ = true;
+            paused_by_error_ = false;
+            reanchor();
+            dirty_ = true;
+            return Outcome{std::nullopt, "", time_result()};
+          },
+          [&](const protocol::SimStep& c) {
+            if (c.n < 1 || c.n > 10000)
+              return Outcome{ErrorCode::BadField, "n: " + std::to_string(c.n) + " is outside 1..10000", {}};
+            // Answered when the last of the n steps is done.
+            step_requests_.push_back({c.n, c.n, std::move(done)});
+            deferred = true;
+            return Outcome{};
+          },
+          [&](const protocol::SimReset&) {
+            const SimState start = initial_state(scene_);
+            rebuild(scene_, start, true);
+            return Outcome{std::nullopt, "", time_result()};
+          },
+          [&](const protocol::SimSpeed& c) {
+            if (!std::isfinite(c.factor) || c.factor < 0 || c.factor > 1000)
+              return Outcome{
+                  ErrorCode::BadField, "factor: must be in (0, 1000], or 0 for as fast as possible", {}};
+            speed_ = c.factor;
+            reanchor();
+            dirty_ = true;
+            return Outcome{std::nullopt, "", Json{{"factor", speed_}}};
+          },
+          [&](const protocol::DryerAim&) {
+            return Outcome{ErrorCode::Failed,
+                           "dryer.aim needs the picked surface point: the render side picks it, then calls "
+                           "Session::aim_dryer",
+                           {}};
+          },
+          [&](const auto&) {
+            return Outcome{ErrorCode::Failed, "not a simulation command", {}};
+          },
+      },
+      command);
+}
+
+Session::Outcome Session::set_dryer(int index, const Dryer& d) {
+  try {
+    solver_->set_dryer(std::size_t(index), d);
+  } catch (const Error& e) {
+    return {ErrorCode::BadField, e.what(), {}};
+  }
+  const Dryer& now = solver_->dryers()[std::size_t(index)];
+  scene_.dryers[std::size_t(index)] = now;
+  const Json fields = dryer_json(now);
+  Json& source = scene_.source["dryers"][std::size_t(index)];
+  for (const auto& [key, value] : fields.items()) source[key] = value;
+  {
+    std::lock_guard lock(publish_mutex_);
+    scene_published_ = std::make_shared<const Scene>(scene_);
+  }
+  dirty_ = true;
+  Json result = fields;
+  result["dryer"] = index;
+  return {std::nullopt, "", result};
+}
+
+Session::Outcome Session::apply(const protocol::DryerSet& c) {
+  const std::size_t count = solver_->dryers().size();
+  if (c.dryer < 0 || std::size_t(c.dryer) >= count)
+    return {ErrorCode::NotFound,
+            "dryer " + std::to_string(c.dryer) + " does not exist; the scene has " + std::to_string(count),
+            {}};
+  Dryer d = solver_->dryers()[std::size_t(c.dryer)];
+  if (c.on) d.on = *c.on;
+  if (c.position) d.position = *c.position;
+  if (c.direction) d.direction = *c.direction;
+  if (c.temperature) d.temperature = *c.temperature;
+  if (c.speed) d.speed = *c.speed;
+  if (c.half_angle) d.half_angle = *c.half_angle;
+  if (c.reach) d.reach = *c.reach;
+  return set_dryer(c.dryer, d);
+}
+
+Session::Outcome Session::aim(const Aim& a) {
+  const std::size_t count = solver_->dryers().size();
+  if (a.dryer < 0 || std::size_t(a.dryer) >= count)
+    return {ErrorCode::NotFound,
+            "dryer " + std::to_string(a.dryer) + " does not exist; the scene has " + std::to_string(count),
+            {}};
+  Dryer d = solver_->dryers()[std::size_t(a.dryer)];
+  const Eigen::Vector3d toward = a.hit - d.position;
+  if (!a.hit.allFinite() || toward.norm() < 1e-9)
+    return {ErrorCode::BadField, "the picked point is not finite or lies at the nozzle", {}};
+  d.direction = toward.normalized();
+  return set_dryer(a.dryer, d);
+}
+
+Session::Outcome Session::apply(const protocol::LampSet& c) {
+  const std::size_t count = solver_->lamps().size();
+  if (c.lamp < 0 || std::size_t(c.lamp) >= count)
+    return {ErrorCode::NotFound,
+            "lamp " + std::to_string(c.lamp) + " does not exist; the scene has " + std::to_string(count),
+            {}};
+  Lamp l = solver_->lamps()[std::size_t(c.lamp)];
+  if (c.on) l.on = *c.on;
+  if (c.centre) l.centre = *c.centre;
+  if (c.normal) l.normal = *c.normal;
+  if (c.temperature) l.temperature = *c.temperature;
+  if (c.emissivity) l.emissivity = *c.emissivity;
+  try {
+    solver_->set_lamp(std::size_t(c.lamp), l);
+  } catch (const Error& e) {
+    return {ErrorCode::BadField, e.what(), {}};
+  }
+  const Lamp& now = solver_->lamps()[std::size_t(c.lamp)];
+  scene_.lamps[std::size_t(c.lamp)] = now;
+  const Json fields = lamp_json(now);
+  Json& source = scene_.source["lamps"][std::size_t(c.lamp)];
+  for (const auto& [key, value] : fields.items()) source[key] = value;
+  {
+    std::lock_guard lock(publish_mutex_);
+    scene_published_ = std::make_shared<const Scene>(scene_);
+  }
+  dirty_ = true;
+  Json result = fields;
+  result["lamp"] = c.lamp;
+  return {std::nullopt, "", result};
+}
+
+Session::Outcome Session::apply(const protocol::SceneLoad& c) {
+  // Only scenes in configs/: a client names one, it never hands the server a path.
+  const std::string& name = c.name;
+  if (name.empty() || name.front() == '.' || name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
+    return {ErrorCode::BadField,
+            "name: a scene is named by its file in configs/, without a path: '" + name + "'",
+            {}};
+  const fs::path configs = fs::path(THAW_SOURCE_DIR) / "configs";
+  std::string file;
+  try {
+    file = resolve_scene_path((configs / name).string());
+  } catch (const Error&) {
+    return {ErrorCode::NotFound, "no scene named '" + name + "' in configs/", {}};
+  }
+  Scene scene;
+  try {
+    scene = load_scene(file, overrides_);
+  } catch (const Error& e) {
+    return {ErrorCode::Failed, e.what(), {}};
+  }
+  const SimState start = initial_state(scene);
+  rebuild(std::move(scene), start, true);
+  Json result = time_result();
+  result["scene"] = scene_.name;
+  result["particles"] = solver_->size();
+  return {std::nullopt, "", result};
+}
+
+Session::Outcome Session::apply(const protocol::ParamSet& c) {
+  const Field* field = find_field(scene_schema(), c.path);
+  if (!field || !field->settable)
+    return {ErrorCode::BadField, "path: '" + c.path + "' is not a parameter a client may change", {}};
+  Scene scene;
+  try {
+    Json doc = scene_.source;
+    apply_override(doc, c.path + "=" + c.value.dump());
+    scene = scene_from_json(std::move(doc));
+  } catch (const Error& e) {
+    return {ErrorCode::BadField, e.what(), {}};
+  }
+  // The new scene starts from the particles as they are, so the change takes effect mid-run.
+  rebuild(std::move(scene), solver_->state(), false);
+  return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}}};
+}
+
+Session::Outcome Session::apply(const protocol::StateSave& c) {
+  if (!valid_state_name(c.name))
+    return {ErrorCode::BadField, "name: 1 to 64 of A-Z, a-z, 0-9, '_' and '-', got '" + c.name + "'", {}};
+  const std::string path = (fs::path(state_dir_) / (c.name + ".state")).string();
+  SimState st = solver_->state();
+  st.scene_json = scene_.source.dump();
+  try {
+    write_state_file(path, st);
+  } catch (const Error& e) {
+    return {ErrorCode::Failed, e.what(), {}};
+  }
+  Json result = time_result();
+  result["name"] = c.name;
+  return {std::nullopt, "", result};
+}
+
+Session::Outcome Session::apply(const protocol::StateLoad& c) {
+  if (!valid_state_name(c.name))
+    return {ErrorCode::BadField, "name: 1 to 64 of A-Z, a-z, 0-9, '_' and '-', got '" + c.name + "'", {}};
+  const std::string path = (fs::path(state_dir_) / (c.name + ".state")).string();
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    return {ErrorCode::NotFound, "no saved state named '" + c.name + "'", {}};
+  SimState st;
+  Scene scene;
+  try {
+    st = read_state_file(path);
+    scene = scene_from_json(Json::parse(st.scene_json));
+  } catch (const std::exception& e) {
+    return {ErrorCode::Failed, "state '" + c.name + "': " + e.what(), {}};
+  }
+  rebuild(std::move(scene), st, true);
+  // ice_fraction is of the scene's start, not of the moment the state was saved.
+  start_ice_mass_ = ice_mass_of(initial_state(scene_).particles, scene_, solver_->constants().rest_density);
+  Json result = time_result();
+  result["name"] = c.name;
+  return {std::nullopt, "", result};
+}
+
+void Session::rebuild(Scene scene, const SimState& state, bool fresh_start) {
+  // Build the new solver before dropping the old one: a failure leaves the running simulation as it was.
+  auto solver = std::make_unique<Solver>(cl_, scene, state);
+  solver->warm_up();
+  solver_ = std::move(solver);
+  scene_ = std::move(scene);
+  if (fresh_start) {
+    fail_step_requests("interrupted: the simulation was reset or replaced");
+    start_ice_mass_ = ice_mass_of(state.particles, scene_, solver_->constants().rest_density);
+  }
+  error_.clear();
+  // A blow-up paused the run, not the user: a fresh state carries on where the user left it.
+  if (paused_by_error_) running_ = true;
+  paused_by_error_ = false;
+  reanchor();
+  window_start_steps_ = solver_->steps();
+  window_step_seconds_ = 0;
+  {
+    std::lock_guard lock(publish_mutex_);
+    scene_published_ = std::make_shared<const Scene>(scene_);
+  }
+  dirty_ = true;
+}
+
+void Session::step_once() {
+  const auto t0 = Clock::now();
+  try {
+    solver_->step();
+    error_.clear();
+  } catch (const std::exception& e) {
+    // A blow-up (or a device failure) pauses and reports; the service keeps serving, and reset,
+    // scene.load or state.load recover.
+    error_ = e.what();
+    running_ = false;
+    paused_by_error_ = true;
+    std::fprintf(stderr, "thaw serve: simulation paused: %s\n", e.what());
+    fail_step_requests(error_);
+    publish();
+    return;
+  }
+  window_step_seconds_ += std::chrono::duration<double>(Clock::now() - t0).count();
+  dirty_ = true;
+}
+
+void Session::fail_step_requests(const std::string& why) {
+  std::deque<StepRequest> failed;
+  failed.swap(step_requests_);
+  for (StepRequest& r : failed) {
+    Json result = time_result();
+    result["done"] = r.requested - r.remaining;
+    answer(r.done, ErrorCode::Failed, why, result);
+  }
+}
+
+void Session::reanchor() {
+  anchor_wall_ = Clock::now();
+  anchor_sim_ = solver_ ? solver_->time() : 0.0;
+}
+
+Json Session::time_result() const {
+  return {{"time", solver_->time()}, {"steps", solver_->steps()}, {"paused", !running_}};
+}
+
+void Session::maybe_publish() {
+  if (Clock::now() - last_publish_ >= std::chrono::duration<double>(1.0 / kPublishRate)) publish();
+}
+
+void Session::publish() {
+  const auto now = Clock::now();
+  const double wall = std::chrono::duration<double>(now - last_publish_).count();
+  const std::uint64_t steps = solver_->steps();
+  const std::uint64_t window_steps = steps - std::min(steps, window_start_steps_);
+  if (window_steps > 0) last_step_ms_ = 1e3 * window_step_seconds_ / double(window_steps);
+
+  std::shared_ptr<const RenderSnapshot> snapshot;
+  Json stats = {{"type", "stats"}, {"scene", scene_.name}, {"time", solver_->time()}, {"steps", steps}};
+  try {
+    // One read of the device serves the picture and the numbers.
+    const HostParticles p = solver_->particles();
+    const Scene& scene = solver_->scene();
+    const std::vector<float> temperature = temperatures_of(p, scene);
+    snapshot = std::make_shared<const RenderSnapshot>(
+        make_snapshot(p, temperature.size() == p.size() ? temperature : std::vector<float>{}, scene,
+                      solver_->time(), steps));
+    Metrics m = measure(p, scene, solver_->constants().rest_density);
+    m.budget = solver_->energy_budget();
+    stats["dt"] = solver_->dt();
+    stats["steps_per_second"] = wall > 0 ? double(window_steps) / wall : 0.0;
+    stats["step_ms"] = last_step_ms_;
+    stats["speed"] = speed_;
+    Json counts = Json::object();
+    for (int i = 0; i < kPhaseCount; ++i) counts[phase_name(static_cast<Phase>(i))] = m.count[i];
+    stats["particles"] = counts;
+    stats["ice_mass"] = m.ice_mass;
+    stats["water_mass"] = m.water_mass;
+    stats["ice_fraction"] = start_ice_mass_ > 0 ? Json(m.ice_mass / start_ice_mass_) : Json(nullptr);
+    if (m.heat) {
+      const EnergyBudget& b = m.budget;
+      const double gross =
+          std::abs(b.ambient) + std::abs(b.lamps) + std::abs(b.dryers) + std::abs(b.walls) + std::abs(b.held);
+      stats["temperature"] = {
+          {"min", m.min_temperature}, {"mean", m.mean_temperature}, {"max", m.max_temperature}};
+      stats["energy"] = {{"heat_in", b.heat_in()},
+                         {"closure", m.closure()},
+                         {"closure_relative", m.closure() / std::max({m.enthalpy_scale, gross, 1e-300})}};
+    }
+  } catch (const std::exception& e) {
+    // The device would not give the state back: report it and keep the last picture.
+    error_ = std::string("reading the simulation state failed: ") + e.what();
+    running_ = false;
+    paused_by_error_ = true;
+  }
+  stats["paused"] = !running_;
+  if (!error_.empty()) stats["error"] = error_;
+
+  auto shared_stats = std::make_shared<const Json>(std::move(stats));
+  {
+    std::lock_guard lock(publish_mutex_);
+    if (snapshot) snapshot_ = std::move(snapshot);
+    stats_ = std::move(shared_stats);
+    ++sequence_;
+  }
+  publish_cv_.notify_all();
+  {
+    std::lock_guard lock(listeners_mutex_);
+    for (auto& [id, listener] : listeners_) listener();
+  }
+  last_publish_ = now;
+  window_start_steps_ = steps;
+  window_step_seconds_ = 0;
+  dirty_ = false;
+}
+
+}  // namespace thaw

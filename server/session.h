@@ -1,0 +1,174 @@
+#pragma once
+// The simulation thread of `thaw serve` (DESIGN.md, Server): it owns the Solver, applies the commands the
+// network loop queues between two steps, and publishes what the other threads read — a render snapshot
+// and a stats event — by swapping shared pointers under a mutex. It never waits on a consumer: a reader
+// takes the newest value when it likes, and a slow one simply misses intermediate ones.
+//
+// Threads: the constructor and start() run on the owner's thread; everything that touches the Solver
+// (stepping, commands, snapshots, state files) runs on the session's own thread once started. The
+// accessors and submit() may be called from any thread.
+#include <Eigen/Core>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "render/snapshot.h"
+#include "server/protocol.h"
+#include "sim/cl_runtime.h"
+#include "sim/scene.h"
+#include "sim/schema.h"
+#include "sim/state_file.h"
+
+namespace thaw {
+
+class Solver;
+
+class Session {
+ public:
+  // How a command ended: no code on success (`result` then holds what changed, for the ack), else the
+  // protocol's error code and a message naming what was wrong. Called on the session's thread, after
+  // the stats and snapshot that show the command's effect have been published.
+  using Done = std::function<void(std::optional<protocol::ErrorCode> code, std::string message, Json result)>;
+
+  // Loads `scene_name` (a name in configs/ or a file) with `overrides` ("path=value"), builds and warms
+  // up the solver, creates `state_dir` and publishes the first snapshot. The overrides apply to every
+  // scene this session loads later too (scene.load), so an operator's e.g. "spacing=0.006" for a slow
+  // machine holds for the whole service. Throws SceneError / Error like load_scene and the Solver.
+  Session(ClRuntime& cl, std::string scene_name, std::vector<std::string> overrides, std::string state_dir);
+  ~Session();  // stops
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  void start();  // launches the simulation thread; it runs (not paused) from the start
+  void stop();   // finishes the step under way, fails the commands still queued, joins
+
+  // Thread-safe; applied on the session's thread before its next step. A `done` may be empty.
+  // Presentation commands (hello, camera, view, quality, frame.ack) are the render side's business and
+  // end in Failed; dryer.aim too, since it needs a pick: the render side picks, then calls aim_dryer().
+  void submit(protocol::Command command, Done done = {});
+  // Points dryer `dryer` from where it is toward `hit` [m] (a picked surface point).
+  void aim_dryer(int dryer, const Eigen::Vector3d& hit, Done done = {});
+
+  // Writes the current state to `path` (for --state-out at shutdown). On the session's thread while it
+  // runs (blocking the caller until written), directly when it does not; throws Error on failure.
+  void save_state(const std::string& path);
+
+  // Simulated seconds per wall second; 0: as fast as the device allows (the default, since real time
+  // is far too slow for a melt). Also settable with sim.speed; values in (0, 1000] there.
+  static constexpr double kUnlimited = 0.0;
+
+  // ---- what the session publishes (thread-safe) ------------------------------------------------------
+  std::shared_ptr<const RenderSnapshot> latest_snapshot() const;
+  // The protocol's stats event: {"type": "stats", scene, time [s], steps, dt [s], steps_per_second and
+  // step_ms (wall, over the last publish interval), speed (0: unlimited), particles {water, ice, solid,
+  // air}, ice_mass and water_mass [kg], ice_fraction (of the scene's start; null without ice), with heat
+  // temperature {min, mean, max} [°C] over ice and water and energy {heat_in, closure [J],
+  // closure_relative}, paused, and error (the step failure that paused the run) while there is one}.
+  std::shared_ptr<const Json> latest_stats() const;
+  std::shared_ptr<const Scene> scene() const;  // the scene as it runs now, live changes included
+  std::uint64_t sequence() const;              // bumped by every publish
+  // Waits until sequence() > after or `timeout` passes; returns sequence().
+  std::uint64_t wait_for_sequence(std::uint64_t after, std::chrono::milliseconds timeout) const;
+
+  // Called on the session's thread after every publish, e.g. to wake the network loop or the render
+  // thread. Must be quick and must not call back into subscribe/unsubscribe.
+  int subscribe(std::function<void()> on_publish);
+  void unsubscribe(int id);  // after it returns, that callback is not running and never runs again
+
+  // How often the session publishes at most while it steps [Hz].
+  static constexpr double kPublishRate = 60.0;
+
+ private:
+  struct Aim {
+    int dryer = 0;
+    Eigen::Vector3d hit = Eigen::Vector3d::Zero();
+  };
+  using Task = std::function<void()>;  // internal work on the session's thread (save_state)
+  struct Pending {
+    std::variant<protocol::Command, Aim, Task> what;
+    Done done;
+  };
+  struct Outcome {
+    std::optional<protocol::ErrorCode> code;
+    std::string message;
+    Json result = Json::object();
+  };
+  struct StepRequest {
+    int remaining = 0, requested = 0;
+    Done done;
+  };
+
+  void run();
+  bool wait_for_work(std::optional<std::chrono::steady_clock::time_point> until);
+  void apply_pending(std::deque<Pending>& batch);
+  Outcome apply(const protocol::Command& command, Done& done, bool& deferred);
+  Outcome apply(const protocol::DryerSet& c);
+  Outcome apply(const protocol::LampSet& c);
+  Outcome apply(const protocol::SceneLoad& c);
+  Outcome apply(const protocol::ParamSet& c);
+  Outcome apply(const protocol::StateSave& c);
+  Outcome apply(const protocol::StateLoad& c);
+  Outcome aim(const Aim& a);
+  Outcome set_dryer(int index, const Dryer& d);
+
+  void step_once();
+  void rebuild(Scene scene, const SimState& state, bool fresh_start);
+  void fail_step_requests(const std::string& why);
+  void reanchor();
+  Json time_result() const;
+  void publish();
+  void maybe_publish();
+
+  ClRuntime& cl_;
+  std::vector<std::string> overrides_;
+  std::string state_dir_;
+
+  // Owned by the session's thread once started (the constructor's before).
+  Scene scene_;  // source kept in step with live dryer/lamp changes, so state files and rebuilds keep them
+  std::unique_ptr<Solver> solver_;
+  bool running_ = true;
+  bool paused_by_error_ = false;
+  std::string error_;  // the last step failure, shown in stats until a step succeeds or the state is rebuilt
+  double speed_ = kUnlimited;
+  double start_ice_mass_ = 0;  // ice mass of the scene's initial state [kg], for ice_fraction
+  std::deque<StepRequest> step_requests_;
+  std::chrono::steady_clock::time_point anchor_wall_;
+  double anchor_sim_ = 0;
+  // The publish window: steps and step wall time since the last publish.
+  std::chrono::steady_clock::time_point last_publish_;
+  std::uint64_t window_start_steps_ = 0;
+  double window_step_seconds_ = 0;
+  double last_step_ms_ = 0;
+  bool dirty_ = false;  // something changed that is not published yet
+
+  // Command queue: the network loop (and the owner) -> the session's thread.
+  std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<Pending> queue_;
+  bool stop_ = false;
+  bool thread_running_ = false;
+  std::thread thread_;
+
+  // Published values.
+  mutable std::mutex publish_mutex_;
+  mutable std::condition_variable publish_cv_;
+  std::shared_ptr<const RenderSnapshot> snapshot_;
+  std::shared_ptr<const Json> stats_;
+  std::shared_ptr<const Scene> scene_published_;
+  std::uint64_t sequence_ = 0;
+
+  std::mutex listeners_mutex_;
+  std::vector<std::pair<int, std::function<void()>>> listeners_;
+  int next_listener_ = 1;
+};
+
+}  // namespace thaw

@@ -1,0 +1,344 @@
+// The simulation thread (Session) and the render thread (RenderWorker) of `thaw serve`, driven the way the
+// network loop drives them: commands in through submit(), answers through the completion, and the
+// published stats, snapshots and frames read from other threads.
+#include "server/session.h"
+
+#include <chrono>
+#include <future>
+#include <thread>
+
+#include "server/render_worker.h"
+#include "sim/error.h"
+#include "tests/test_support.h"
+
+namespace thaw {
+namespace {
+
+using namespace std::chrono_literals;
+using protocol::ErrorCode;
+using testing::TempDir;
+
+struct Reply {
+  bool answered = false;
+  std::optional<ErrorCode> code;
+  std::string message;
+  Json result;
+};
+
+// Submits and waits for the completion, as the network loop would (it marshals the answer instead).
+Reply call(Session& s, protocol::Command c, std::chrono::milliseconds timeout = 20s) {
+  auto promise = std::make_shared<std::promise<Reply>>();
+  std::future<Reply> answer = promise->get_future();
+  s.submit(std::move(c), [promise](std::optional<ErrorCode> code, std::string message, Json result) {
+    promise->set_value({true, code, std::move(message), std::move(result)});
+  });
+  if (answer.wait_for(timeout) != std::future_status::ready) return {};
+  return answer.get();
+}
+
+// Waits until the published stats satisfy `ok`; returns them (or the last ones on timeout).
+template <class F>
+std::shared_ptr<const Json> wait_for_stats(const Session& s, F ok, std::chrono::milliseconds timeout = 10s) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    const std::uint64_t seq = s.sequence();
+    auto stats = s.latest_stats();
+    if (ok(*stats) || std::chrono::steady_clock::now() > end) return stats;
+    s.wait_for_sequence(seq, 100ms);
+  }
+}
+
+class SessionTest : public testing::ClSuite {
+ protected:
+  std::unique_ptr<Session> make(const std::string& scene, std::vector<std::string> extra = {}) {
+    std::vector<std::string> overrides = {"spacing=0.006"};
+    overrides.insert(overrides.end(), extra.begin(), extra.end());
+    return std::make_unique<Session>(cl(), scene, overrides, (dir_.path() / "states").string());
+  }
+  TempDir dir_{"session"};
+};
+
+TEST_F(SessionTest, PublishesSnapshotsAndStats) {
+  auto s = make("ice-on-plate");
+  // The constructor publishes the starting state, so a viewer has a picture before the first step.
+  ASSERT_TRUE(s->latest_snapshot());
+  EXPECT_EQ((*s->latest_stats())["type"], "stats");
+  EXPECT_EQ((*s->latest_stats())["steps"], 0);
+  const std::uint64_t first = s->sequence();
+  s->start();
+  auto stats = wait_for_stats(*s, [](const Json& j) { return j["steps"].get<std::uint64_t>() >= 3; });
+  EXPECT_GT(s->sequence(), first);
+  EXPECT_GE((*stats)["steps"].get<std::uint64_t>(), 3u);
+  EXPECT_GT((*stats)["time"].get<double>(), 0.0);
+  EXPECT_FALSE((*stats)["paused"].get<bool>());
+  EXPECT_GT((*stats)["particles"]["ice"].get<std::size_t>(), 0u);
+  EXPECT_NEAR((*stats)["ice_fraction"].get<double>(), 1.0, 0.05);
+  EXPECT_TRUE(stats->contains("temperature"));
+  EXPECT_TRUE((*stats)["energy"].contains("closure_relative"));
+  EXPECT_FALSE(stats->contains("error"));
+  const auto snapshot = s->latest_snapshot();
+  std::size_t count = 0;
+  for (const auto& [phase, n] : (*stats)["particles"].items()) count += n.get<std::size_t>();
+  EXPECT_EQ(snapshot->position.size(), count);
+  EXPECT_EQ(snapshot->temperature.size(), count);
+  s->stop();
+}
+
+TEST_F(SessionTest, DryerSetMergesIntoTheDryerAndRefusesBadValues) {
+  auto s = make("default");
+  s->start();
+  const double half_angle = s->scene()->dryers.at(0).half_angle;
+  protocol::DryerSet set;
+  set.dryer = 0;
+  set.speed = 20.0;
+  set.temperature = 80.0;
+  Reply r = call(*s, set);
+  ASSERT_TRUE(r.answered);
+  EXPECT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["speed"], 20.0);
+  EXPECT_EQ(s->scene()->dryers[0].speed, 20.0);
+  EXPECT_EQ(s->scene()->dryers[0].temperature, 80.0);
+  EXPECT_EQ(s->scene()->dryers[0].half_angle, half_angle);  // fields left out keep their value
+
+  protocol::DryerSet fast;
+  fast.speed = 250.0;
+  r = call(*s, fast);
+  ASSERT_TRUE(r.answered);
+  EXPECT_EQ(r.code, ErrorCode::BadField);
+  EXPECT_NE(r.message.find("speed"), std::string::npos) << r.message;
+  EXPECT_EQ(s->scene()->dryers[0].speed, 20.0);
+
+  protocol::DryerSet missing;
+  missing.dryer = 3;
+  missing.on = false;
+  r = call(*s, missing);
+  EXPECT_EQ(r.code, ErrorCode::NotFound);
+
+  // Still stepping after the refusals.
+  const auto steps = (*s->latest_stats())["steps"].get<std::uint64_t>();
+  auto stats = wait_for_stats(*s, [&](const Json& j) { return j["steps"].get<std::uint64_t>() > steps; });
+  EXPECT_GT((*stats)["steps"].get<std::uint64_t>(), steps);
+
+  // Aiming points the dryer from its nozzle at the picked point.
+  const Eigen::Vector3d nozzle = s->scene()->dryers[0].position;
+  auto promise = std::make_shared<std::promise<std::optional<ErrorCode>>>();
+  auto aimed = promise->get_future();
+  s->aim_dryer(0, nozzle + Eigen::Vector3d(0.03, 0, -0.04),
+               [promise](std::optional<ErrorCode> code, std::string, Json) { promise->set_value(code); });
+  ASSERT_EQ(aimed.wait_for(20s), std::future_status::ready);
+  EXPECT_FALSE(aimed.get());
+  EXPECT_TRUE(s->scene()->dryers[0].direction.isApprox(Eigen::Vector3d(0.6, 0, -0.8), 1e-9));
+}
+
+TEST_F(SessionTest, PauseHoldsTimeAndStepAdvancesExactly) {
+  auto s = make("ice-on-plate");
+  s->start();
+  wait_for_stats(*s, [](const Json& j) { return j["steps"].get<std::uint64_t>() >= 2; });
+  Reply r = call(*s, protocol::SimPause{});
+  ASSERT_TRUE(r.answered);
+  ASSERT_FALSE(r.code) << r.message;
+  const auto steps = r.result["steps"].get<std::uint64_t>();
+  const double time = r.result["time"].get<double>();
+  std::this_thread::sleep_for(150ms);
+  EXPECT_EQ((*s->latest_stats())["steps"].get<std::uint64_t>(), steps);
+  EXPECT_EQ((*s->latest_stats())["time"].get<double>(), time);
+  EXPECT_TRUE((*s->latest_stats())["paused"].get<bool>());
+
+  r = call(*s, protocol::SimStep{5});
+  ASSERT_TRUE(r.answered);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["steps"].get<std::uint64_t>(), steps + 5);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ((*s->latest_stats())["steps"].get<std::uint64_t>(), steps + 5);
+  EXPECT_GT((*s->latest_stats())["time"].get<double>(), time);
+
+  EXPECT_EQ(call(*s, protocol::SimStep{0}).code, ErrorCode::BadField);
+  r = call(*s, protocol::SimResume{});
+  EXPECT_FALSE(r.code);
+  wait_for_stats(*s, [&](const Json& j) { return j["steps"].get<std::uint64_t>() > steps + 5; });
+  EXPECT_GT((*s->latest_stats())["steps"].get<std::uint64_t>(), steps + 5);
+}
+
+TEST_F(SessionTest, ResetGoesBackToTheStart) {
+  auto s = make("ice-on-plate");
+  s->start();
+  wait_for_stats(*s, [](const Json& j) { return j["steps"].get<std::uint64_t>() >= 3; });
+  Reply r = call(*s, protocol::SimReset{});
+  ASSERT_TRUE(r.answered);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["time"].get<double>(), 0.0);
+  EXPECT_EQ(r.result["steps"].get<std::uint64_t>(), 0u);
+}
+
+TEST_F(SessionTest, StateSaveAndLoadRoundTripInsideTheStateFolder) {
+  auto s = make("ice-on-plate");
+  s->start();
+  wait_for_stats(*s, [](const Json& j) { return j["steps"].get<std::uint64_t>() >= 2; });
+  ASSERT_FALSE(call(*s, protocol::SimPause{}).code);
+  Reply saved = call(*s, protocol::StateSave{"snap_1"});
+  ASSERT_TRUE(saved.answered);
+  ASSERT_FALSE(saved.code) << saved.message;
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir_.path() / "states" / "snap_1.state"));
+
+  ASSERT_FALSE(call(*s, protocol::SimStep{3}).code);
+  Reply loaded = call(*s, protocol::StateLoad{"snap_1"});
+  ASSERT_TRUE(loaded.answered);
+  ASSERT_FALSE(loaded.code) << loaded.message;
+  EXPECT_EQ(loaded.result["steps"], saved.result["steps"]);
+  EXPECT_EQ(loaded.result["time"], saved.result["time"]);
+  EXPECT_EQ((*s->latest_stats())["steps"], saved.result["steps"]);
+
+  // Names never become paths: nothing is written beside (or above) the state folder.
+  EXPECT_EQ(call(*s, protocol::StateSave{"../evil"}).code, ErrorCode::BadField);
+  EXPECT_EQ(call(*s, protocol::StateSave{"a/b"}).code, ErrorCode::BadField);
+  EXPECT_FALSE(std::filesystem::exists(dir_.path() / "evil.state"));
+  EXPECT_FALSE(std::filesystem::exists(dir_.path() / "states" / "a"));
+  EXPECT_EQ(call(*s, protocol::StateLoad{"../evil"}).code, ErrorCode::BadField);
+  EXPECT_EQ(call(*s, protocol::StateLoad{"never_saved"}).code, ErrorCode::NotFound);
+
+  // A damaged file is a Failed load, and the running simulation is left as it was.
+  testing::write_text(dir_.path() / "states" / "broken.state", "not a state file");
+  Reply broken = call(*s, protocol::StateLoad{"broken"});
+  EXPECT_EQ(broken.code, ErrorCode::Failed);
+  EXPECT_EQ((*s->latest_stats())["steps"], saved.result["steps"]);
+
+  // save_state() for shutdown, while the thread runs and after it stopped.
+  s->save_state(dir_ / "running.state");
+  s->stop();
+  s->save_state(dir_ / "stopped.state");
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir_.path() / "running.state"));
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir_.path() / "stopped.state"));
+  EXPECT_EQ(call(*s, protocol::SimResume{}).code, ErrorCode::Failed);  // answered, not left hanging
+}
+
+TEST_F(SessionTest, SceneLoadOnlyFromConfigs) {
+  auto s = make("ice-on-plate");
+  s->start();
+  Reply r = call(*s, protocol::SceneLoad{"no-such-scene"});
+  ASSERT_TRUE(r.answered);
+  EXPECT_EQ(r.code, ErrorCode::NotFound);
+  EXPECT_EQ(call(*s, protocol::SceneLoad{"../configs/default"}).code, ErrorCode::BadField);
+  EXPECT_EQ(call(*s, protocol::SceneLoad{"/etc/passwd"}).code, ErrorCode::BadField);
+  EXPECT_EQ(s->scene()->name, "ice-on-plate");
+
+  r = call(*s, protocol::SceneLoad{"default"});
+  ASSERT_TRUE(r.answered);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(s->scene()->name, "default");
+  EXPECT_EQ(s->scene()->spacing, 0.006);  // the session's overrides hold for every scene it loads
+  EXPECT_EQ(s->scene()->dryers.size(), 1u);
+}
+
+TEST_F(SessionTest, ParamSetTakesEffectAndKeepsTheParticles) {
+  auto s = make("ice-on-plate");
+  s->start();
+  wait_for_stats(*s, [](const Json& j) { return j["steps"].get<std::uint64_t>() >= 2; });
+  ASSERT_FALSE(call(*s, protocol::SimPause{}).code);
+  const auto steps = (*s->latest_stats())["steps"].get<std::uint64_t>();
+  Reply r = call(*s, protocol::ParamSet{"heat.time_scale", 50});
+  ASSERT_TRUE(r.answered);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(s->scene()->heat.time_scale, 50.0);
+  EXPECT_EQ((*s->latest_stats())["steps"].get<std::uint64_t>(), steps);
+
+  EXPECT_EQ(call(*s, protocol::ParamSet{"heat.time_scale", -1}).code, ErrorCode::BadField);
+  EXPECT_EQ(call(*s, protocol::ParamSet{"spacing", 0.01}).code, ErrorCode::BadField);  // not live
+  EXPECT_EQ(s->scene()->heat.time_scale, 50.0);
+  ASSERT_FALSE(call(*s, protocol::SimStep{2}).code);
+}
+
+TEST_F(SessionTest, BlowUpPausesAndReportsWithoutCrashing) {
+  // A block thrown down at 1 m/s under a speed limit of 1.02 m/s: gravity breaks the limit within
+  // a few milliseconds of simulated time.
+  auto s = make("water-drop", {"spacing=0.01", "solver.max_speed=1.02"});
+  s->start();
+  auto stats = wait_for_stats(*s, [](const Json& j) { return j.contains("error"); });
+  ASSERT_TRUE(stats->contains("error"));
+  EXPECT_TRUE((*stats)["paused"].get<bool>());
+  EXPECT_FALSE((*stats)["error"].get<std::string>().empty());
+  EXPECT_EQ(call(*s, protocol::SimStep{1}).code, ErrorCode::Failed);
+  // Still serving commands.
+  Reply r = call(*s, protocol::SimReset{});
+  ASSERT_TRUE(r.answered);
+  EXPECT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["steps"].get<std::uint64_t>(), 0u);
+  EXPECT_EQ(call(*s, protocol::CameraSet{}).code, ErrorCode::Failed);  // not the session's business
+}
+
+// The (width, height) in a baseline or progressive JPEG's start-of-frame segment.
+std::pair<int, int> jpeg_size(const std::string& j) {
+  for (std::size_t i = 2; i + 9 < j.size();) {
+    if (std::uint8_t(j[i]) != 0xFF) return {0, 0};
+    const std::uint8_t marker = std::uint8_t(j[i + 1]);
+    const std::size_t length = std::uint8_t(j[i + 2]) * 256u + std::uint8_t(j[i + 3]);
+    if (marker == 0xC0 || marker == 0xC1 || marker == 0xC2)
+      return {std::uint8_t(j[i + 7]) * 256 + std::uint8_t(j[i + 8]),
+              std::uint8_t(j[i + 5]) * 256 + std::uint8_t(j[i + 6])};
+    i += 2 + length;
+  }
+  return {0, 0};
+}
+
+class RenderWorkerTest : public testing::ClSuite {
+ protected:
+  TempDir dir_{"render-worker"};
+};
+
+TEST_F(RenderWorkerTest, RendersNumberedJpegFramesAndPicksTheIce) {
+  Session s(cl(), "ice-on-plate", {"spacing=0.006"}, (dir_.path() / "states").string());
+  s.start();
+  std::atomic<int> notified{0};
+  RenderWorker w(s, {}, [&] { ++notified; });
+  EXPECT_THROW(w.set_quality(8, std::nullopt, std::nullopt, std::nullopt, std::nullopt), Error);
+  w.set_quality(160, 120, 70, 60.0, "fast");
+  w.start();
+  auto first = w.wait_for_frame(0, 30s);
+  if (!first && w.status().rfind("error", 0) == 0) {
+    // No EGL here: the worker said so and keeps running; the CPU views still give frames.
+    std::printf("surface view unavailable (%s); testing the particle view\n", w.status().c_str());
+    w.set_view("particles");
+    first = w.wait_for_frame(0, 30s);
+  }
+  ASSERT_TRUE(first) << w.status();
+  EXPECT_EQ(w.status().rfind("ok", 0), 0u) << w.status();
+  ASSERT_GT(first->jpeg.size(), 2u);
+  EXPECT_EQ(std::uint8_t(first->jpeg[0]), 0xFF);
+  EXPECT_EQ(std::uint8_t(first->jpeg[1]), 0xD8);
+  EXPECT_EQ(first->width, 160);
+  EXPECT_EQ(first->height, 120);
+  EXPECT_EQ(jpeg_size(first->jpeg), std::make_pair(160, 120));
+
+  auto second = w.wait_for_frame(first->frame, 30s);
+  ASSERT_TRUE(second);
+  EXPECT_GT(second->frame, first->frame);
+  EXPECT_GE(second->step, first->step);
+  EXPECT_GE(notified.load(), 1);  // the first frame's callback ran before the second frame began
+
+  // The default camera looks at the domain's centre, where the cube sits on its plate.
+  auto hit = w.pick(80, 60);
+  ASSERT_TRUE(hit);
+  EXPECT_GT(hit->hit.x(), 0.035);
+  EXPECT_LT(hit->hit.x(), 0.085);
+  EXPECT_GT(hit->hit.y(), 0.035);
+  EXPECT_LT(hit->hit.y(), 0.085);
+  EXPECT_GT(hit->hit.z(), 0.0);
+  EXPECT_LT(hit->hit.z(), 0.05);
+  EXPECT_NEAR(hit->normal.norm(), 1.0, 1e-6);
+  EXPECT_FALSE(w.pick(1, 1));  // a corner of the picture shows only background
+
+  // A new size takes effect with the next frame.
+  w.set_quality(96, 64, std::nullopt, std::nullopt, std::nullopt);
+  w.orbit(20, 5, 0.9);
+  auto resized = w.wait_for_frame(second->frame, 30s);
+  for (int i = 0; i < 5 && resized && resized->width != 96; ++i)
+    resized = w.wait_for_frame(resized->frame, 30s);
+  ASSERT_TRUE(resized);
+  EXPECT_EQ(resized->width, 96);
+  EXPECT_EQ(resized->height, 64);
+  EXPECT_EQ(jpeg_size(resized->jpeg), std::make_pair(96, 64));
+  w.stop();
+  s.stop();
+}
+
+}  // namespace
+}  // namespace thaw
