@@ -41,7 +41,10 @@ int cmd_serve(int argc, char** argv) {
   ClRuntime cl(args.value("--device").value_or(""));
   Session session(cl, scene, args.sets(), args.value("--state-dir").value_or("thaw-states"));
   std::atomic<Service*> service_ptr{nullptr};
-  RenderWorker renderer(session, RenderOptions{}, [&] {
+  // Looking down at 50 degrees shows what lies inside a glass or a tank, which the melting scenes have.
+  RenderOptions view;
+  view.elevation = 50.0;
+  RenderWorker renderer(session, view, [&] {
     if (Service* s = service_ptr.load()) s->frame_ready();
   });
   Service service(session, renderer, service_options);
