@@ -120,6 +120,20 @@ OrbitCamera camera_for(const RenderOptions& o, const RenderSnapshot& s) {
   return c;
 }
 
+Image render_cpu_view(const RenderOptions& o, const RenderSnapshot& s, const OrbitCamera& camera) {
+  if (o.view == "particles") {
+    ParticleViewOptions p;
+    p.colour_by = o.colour_by;
+    return render_particles(s, camera, p).image;
+  }
+  SliceOptions slice;
+  slice.axis = o.slice_axis;
+  slice.position = o.slice_position;
+  slice.width = o.width;
+  slice.height = o.height;
+  return render_slice(s, slice).image;
+}
+
 FrameRenderer::FrameRenderer(RenderOptions options) : options_(std::move(options)) {
   if (options_.view == "surface") {
     gl_ = std::make_unique<EglContext>();
@@ -143,21 +157,9 @@ Image FrameRenderer::render(const RenderSnapshot& s) {
     times_.readback_ms = t.readback_ms;
     return image;
   }
-  ViewImage v;
-  if (options_.view == "particles") {
-    ParticleViewOptions p;
-    p.colour_by = options_.colour_by;
-    v = render_particles(s, camera_for(options_, s), p);
-  } else {
-    SliceOptions o;
-    o.axis = options_.slice_axis;
-    o.position = options_.slice_position;
-    o.width = options_.width;
-    o.height = options_.height;
-    v = render_slice(s, o);
-  }
+  Image image = render_cpu_view(options_, s, camera_for(options_, s));
   times_.draw_ms = since(t0);
-  return v.image;
+  return image;
 }
 
 std::string FrameRenderer::description() const {

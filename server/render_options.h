@@ -40,6 +40,9 @@ RenderOptions render_options(const CliArgs& args);
 // The camera for a snapshot: the options' angles, framing the scene's domain unless a distance is given.
 OrbitCamera camera_for(const RenderOptions& o, const RenderSnapshot& s);
 
+// The views drawn on the CPU (particles, slice) in the options' settings.
+Image render_cpu_view(const RenderOptions& o, const RenderSnapshot& s, const OrbitCamera& camera);
+
 // Renders snapshots in the options' view; the EGL context is made only for the surface view.
 class FrameRenderer {
  public:

@@ -129,19 +129,9 @@ bool RenderWorker::render_one(const std::shared_ptr<const RenderSnapshot>& snaps
         uploaded_field_options_ = options.field;
       }
       renderer = gl_->context.description();
-    } else if (options.view == "particles") {
-      ParticleViewOptions p;
-      p.colour_by = options.colour_by;
-      image = render_particles(*snapshot, camera, p).image;
-      renderer = "CPU particle view";
     } else {
-      SliceOptions s;
-      s.axis = options.slice_axis;
-      s.position = options.slice_position;
-      s.width = options.width;
-      s.height = options.height;
-      image = render_slice(*snapshot, s).image;
-      renderer = "CPU slice view";
+      image = render_cpu_view(options, *snapshot, camera);
+      renderer = "CPU " + options.view + " view";
     }
     const double render_ms = ms_since(t0);
     const auto t1 = Clock::now();

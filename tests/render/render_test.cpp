@@ -110,6 +110,22 @@ bool differs(const Image& a, const Image& b, int x, int y, int tolerance) {
   return false;
 }
 
+// Pixels that differ from the background image.
+long silhouette(const Image& image, const Image& background) {
+  long count = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) count += differs(image, background, x, y, 2);
+  return count;
+}
+
+// Area in pixels of a sphere of `radius` at `distance` in the image centre: seen from its centre's
+// direction it projects to a disc of angular radius asin(R / d).
+double projected_disc(const OrbitCamera& camera, double radius, double distance) {
+  const double tan_half = std::tan(0.5 * camera.fov * M_PI / 180.0);
+  const double r_px = std::tan(std::asin(radius / distance)) / tan_half * 0.5 * camera.height;
+  return M_PI * r_px * r_px;
+}
+
 double psnr(const Image& a, const Image& b) {
   double se = 0;
   for (int y = 0; y < a.height; ++y)
@@ -245,13 +261,8 @@ TEST_F(RenderTest, SphereSilhouetteHasTheProjectedArea) {
   const OrbitCamera camera = centred_camera(distance, 640, 480);
   const Image bg = background(camera);
   const Image image = renderer().render(f, camera);
-  long count = 0;
-  for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.width; ++x) count += differs(image, bg, x, y, 2);
-  // A sphere seen from its centre's direction projects to a disc of angular radius asin(R / d).
-  const double tan_half = std::tan(0.5 * camera.fov * M_PI / 180.0);
-  const double r_px = std::tan(std::asin(radius / distance)) / tan_half * 0.5 * camera.height;
-  const double area = M_PI * r_px * r_px;
+  const long count = silhouette(image, bg);
+  const double area = projected_disc(camera, radius, distance);
   std::printf("[ info ] silhouette %ld px, projected disc %.0f px\n", count, area);
   EXPECT_NEAR(double(count), area, 0.03 * area);
   // The centre is covered, the corners are background.
@@ -266,19 +277,14 @@ TEST_F(RenderTest, ParticleSampledSphereHasTheProjectedAreaAndPicksItsFront) {
   const float spacing = 0.1f / 12.0f;
   RenderSnapshot s;
   s.spacing = spacing;
-  testing::add_lattice_sphere(s, Vector3f::Zero(), spacing, 12.0f,
-                              Phase::Ice);
+  testing::add_lattice_sphere(s, Vector3f::Zero(), spacing, 12.0f, Phase::Ice);
   const DensityFields f = build_density_fields(s);
   const double radius = 0.1, distance = 0.4;
   const OrbitCamera camera = centred_camera(distance, 640, 480);
   const Image bg = background(camera);
   const Image image = renderer().render(f, camera);
-  long count = 0;
-  for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.width; ++x) count += differs(image, bg, x, y, 2);
-  const double tan_half = std::tan(0.5 * camera.fov * M_PI / 180.0);
-  const double r_px = std::tan(std::asin(radius / distance)) / tan_half * 0.5 * camera.height;
-  const double area = M_PI * r_px * r_px;
+  const long count = silhouette(image, bg);
+  const double area = projected_disc(camera, radius, distance);
   std::printf("[ info ] particle sphere (%zu particles): silhouette %ld px, projected disc %.0f px\n",
               s.position.size(), count, area);
   EXPECT_NEAR(double(count), area, 0.04 * area);
