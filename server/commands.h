@@ -8,4 +8,5 @@ int cmd_info(int argc, char** argv);
 int cmd_scene_doc(int argc, char** argv);
 int cmd_render(int argc, char** argv);
 int cmd_serve(int argc, char** argv);
+int cmd_ctl(int argc, char** argv);
 }  // namespace thaw

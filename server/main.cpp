@@ -16,6 +16,7 @@ const char* kUsage =
     "commands:\n"
     "  serve [SCENE]    the live service: --host 127.0.0.1, --port 8080, --token T, --state-dir DIR,\n"
     "                   --state-out FILE, --set PATH=VALUE, --device D\n"
+    "  ctl URL JSON...  send commands to a running service and print the replies (--token T)\n"
     "  run SCENE        headless run: --until S | --steps N, --set PATH=VALUE, --metrics FILE.jsonl,\n"
     "                   --export DIR, --frames DIR, --export-mesh DIR [--mesh-format obj|ply], every\n"
     "                   --every K steps; --state-out FILE, --state-in FILE, --device D\n"
@@ -49,6 +50,7 @@ int main(int argc, char** argv) {
     if (cmd == "scene-doc") return thaw::cmd_scene_doc(argc, argv);
     if (cmd == "render") return thaw::cmd_render(argc, argv);
     if (cmd == "serve") return thaw::cmd_serve(argc, argv);
+    if (cmd == "ctl") return thaw::cmd_ctl(argc, argv);
     std::fprintf(stderr, "thaw: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;
   } catch (const thaw::BlowUpError& e) {

@@ -55,5 +55,29 @@ asyncio.run(main())
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "final.state")) << "--state-out is written on SIGINT";
 }
 
+// `thaw ctl` from a shell: replies as JSON lines, the exit status says whether all were acknowledged.
+TEST(ServeCtl, SendsCommandsAndPrintsTheReplies) {
+  TempDir dir("serve-ctl");
+  ServedScene served(dir, "ice-on-plate --set spacing=0.006 --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  const std::string url = "ws://127.0.0.1:" + std::to_string(served.port()) + "/";
+  const auto ok = testing::run_thaw("ctl " + url + " '{\"type\": \"sim.pause\"}' '{\"type\": \"sim.step\", \"n\": 3}'", dir);
+  ASSERT_TRUE(ok.exited) << ok.err;
+  EXPECT_EQ(ok.exit_code, 0) << ok.out << ok.err;
+  EXPECT_NE(ok.out.find("\"type\":\"welcome\""), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("\"of\":\"sim.pause\""), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("\"of\":\"sim.step\""), std::string::npos) << ok.out;
+  const auto refused = testing::run_thaw("ctl " + url + " '{\"type\": \"sim.step\", \"n\": 0}'", dir);
+  EXPECT_EQ(refused.exit_code, 1) << refused.out;
+  EXPECT_NE(refused.out.find("\"code\":\"bad_field\""), std::string::npos) << refused.out;
+  const auto bad = testing::run_thaw("ctl " + url + " 'not json'", dir);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("not JSON"), std::string::npos) << bad.err;
+  EXPECT_TRUE(served.stop());
+  const auto gone = testing::run_thaw("ctl " + url + " '{\"type\": \"sim.pause\"}' --timeout 5", dir);
+  EXPECT_EQ(gone.exit_code, 2) << gone.out;
+  EXPECT_NE(gone.err.find(url), std::string::npos) << gone.err;
+}
+
 }  // namespace
 }  // namespace thaw
