@@ -1,0 +1,101 @@
+// The browser client end to end in headless Chromium (Debian's `chromium`), driven through its DevTools
+// protocol by a Python script on python3-websockets: the page loads and connects, frames arrive and are
+// drawn, a click with "aim" ticked points the dryer at the surface under the pointer (the dryer's
+// direction changes in the stats) and the ice keeps melting; a screenshot is saved as an artefact.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "tests/server/serve_support.h"
+
+namespace thaw {
+namespace {
+
+using testing::ServedScene;
+using testing::TempDir;
+
+TEST(BrowserClient, LoadsStreamsAndAimsADryerInHeadlessChromium) {
+  if (!std::filesystem::exists("/usr/bin/chromium")) GTEST_SKIP() << "Debian's chromium is not installed";
+  TempDir dir("browser");
+  ServedScene served(dir, "default --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(R"py(
+import asyncio, base64, json, os, socket, subprocess, tempfile, time, urllib.request, websockets
+s = socket.socket(); s.bind(("127.0.0.1", 0)); DEVTOOLS = s.getsockname()[1]; s.close()
+profile = tempfile.mkdtemp(dir=".")
+chrome = subprocess.Popen(["/usr/bin/chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                           "--no-first-run", "--disable-background-networking", "--disable-component-update",
+                           "--disable-sync", f"--user-data-dir={profile}", f"--remote-debugging-port={DEVTOOLS}",
+                           "--remote-debugging-address=127.0.0.1", "--window-size=1100,700", "about:blank"],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+try:
+    for _ in range(100):
+        try:
+            pages = json.load(urllib.request.urlopen(f"http://127.0.0.1:{DEVTOOLS}/json", timeout=1))
+            page = [p for p in pages if p["type"] == "page"][0]
+            break
+        except Exception:
+            time.sleep(0.2)
+    async def main():
+        async with websockets.connect(page["webSocketDebuggerUrl"], max_size=None) as cdp:
+            ids = iter(range(1, 10**6))
+            async def call(method, **params):
+                i = next(ids)
+                await cdp.send(json.dumps({"id": i, "method": method, "params": params}))
+                while True:
+                    m = json.loads(await asyncio.wait_for(cdp.recv(), 30))
+                    if m.get("id") == i:
+                        return m.get("result", {})
+            async def js(expr):
+                r = await call("Runtime.evaluate", expression=expr, returnByValue=True)
+                return r.get("result", {}).get("value")
+            async def until(expr, seconds):
+                t0 = time.time()
+                while time.time() - t0 < seconds:
+                    v = await js(expr)
+                    if v:
+                        return v
+                    await asyncio.sleep(0.2)
+                return None
+            await call("Page.enable")
+            await call("Page.navigate", url=f"http://127.0.0.1:{PORT}/")
+            print("connected", await until("document.getElementById('connection').textContent === 'connected'", 30))
+            print("frames", bool(await until("framesSeen > 0 || fps > 0", 30)))
+            print("stats", bool(await until("document.getElementById('hud').textContent.includes('ice')", 30)))
+            # The canvas shows the picture, not a blank: many distinct colours in its middle.
+            colours = await js("""(() => { const c = document.getElementById('view');
+                const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; const s = new Set();
+                for (let i = 0; i < d.length; i += 4 * 97) s.add(d[i] + ',' + d[i + 1] + ',' + d[i + 2]);
+                return s.size; })()""")
+            print("colours", colours > 20)
+            before = await js("JSON.stringify(dryers[0].direction)")
+            ice_before = await js("history.length ? history[history.length - 1][1] : 1")
+            await js("document.getElementById('aim').click()")
+            box = await js("(() => { const r = document.getElementById('view').getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; })()")
+            x, y = box[0] + 0.40 * box[2], box[1] + 0.42 * box[3]
+            for kind in ("mousePressed", "mouseReleased"):
+                await call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left", clickCount=1)
+            aimed = await until(f"JSON.stringify(dryers[0].direction) !== {json.dumps(before)}", 20)
+            print("aimed", bool(aimed))
+            melting = await until(f"history.length && history[history.length - 1][1] < {ice_before}", 60)
+            print("melting", bool(melting))
+            shot = await call("Page.captureScreenshot", format="png")
+            with open("browser.png", "wb") as f:
+                f.write(base64.b64decode(shot["data"]))
+            print("screenshot", os.path.getsize("browser.png") > 10000)
+    asyncio.run(main())
+finally:
+    chrome.kill()
+)py", 240, &status);
+  EXPECT_EQ(status, 0) << out;
+  for (const char* line : {"connected True", "frames True", "stats True", "colours True", "aimed True", "melting True",
+                           "screenshot True"})
+    EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
+  std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
+  EXPECT_TRUE(served.stop()) << served.log();
+}
+
+}  // namespace
+}  // namespace thaw
