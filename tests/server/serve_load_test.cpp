@@ -29,48 +29,10 @@ TEST(ServeLoad, FuzzFromSeveralClientsLeavesTheServerUpAndCorrect) {
   ASSERT_GT(served.port(), 0) << served.log();
   int status = 0;
   const std::string out = served.run_python(R"(
-import asyncio, json, random, websockets, thaw_client
-VALID = [{"type": "sim.pause"}, {"type": "sim.resume"}, {"type": "dryer.set", "dryer": 0, "on": True},
-         {"type": "camera.orbit", "d_azimuth": 5}, {"type": "view.set", "view": "particles"},
-         {"type": "quality.set", "width": 320, "height": 240}, {"type": "state.save", "name": "fz"},
-         {"type": "param.set", "path": "heat.time_scale", "value": 50}, {"type": "sim.step", "n": 2}]
-def mutate(rng):
-    m = dict(rng.choice(VALID))
-    kind = rng.randrange(7)
-    if kind == 0: return bytes(rng.randrange(256) for _ in range(rng.randrange(1, 200)))
-    if kind == 1: return json.dumps(m)[: rng.randrange(1, 30)]
-    if kind == 2: m[rng.choice(list(m))] = rng.choice([None, [], {}, "x" * 300, -1e308, 1e308, True, "../../etc"])
-    if kind == 3: m["type"] = rng.choice(["", "dryer", "sim.step.", "x" * 100, 7])
-    if kind == 4: return "x" * rng.choice([16 * 1024 + 1, 70000])
-    if kind == 5: m["extra" + str(rng.randrange(9))] = rng.random()
-    return json.dumps(m)
-async def fuzzer(seed, count):
-    rng = random.Random(seed)
-    async with websockets.connect(f"ws://127.0.0.1:{PORT}/", subprotocols=["thaw.v1"], max_size=None) as ws:
-        for _ in range(count):
-            await ws.send(mutate(rng))
-        # Drain what came back for a moment: errors and acks, never a closed socket.
-        replies = 0
-        try:
-            while True:
-                msg = await asyncio.wait_for(ws.recv(), 0.5)
-                replies += isinstance(msg, str)
-        except asyncio.TimeoutError:
-            pass
-        return replies
-async def main():
-    replies = await asyncio.gather(*[fuzzer(seed, 1500) for seed in range(4)])
-    print("replies", all(r > 0 for r in replies))
-    async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/") as thaw:
-        await thaw.command("sim.resume")
-        before = (await thaw.stats())["steps"]
-        after = (await thaw.stats(lambda s: s["steps"] > before, timeout=30))["steps"]
-        print("still stepping", after > before)
-        try:
-            await thaw.command("dryer.set", dryer=0, speed=1000)
-        except thaw_client.CommandError as e:
-            print("still checking", e.code)
-asyncio.run(main())
+import asyncio, os, sys
+sys.path.insert(0, os.path.join(")" + std::string(THAW_SOURCE_DIR) + R"(", "tests", "server"))
+import service_clients
+asyncio.run(service_clients.fuzz(PORT))
 )", 240, &status);
   EXPECT_EQ(status, 0) << out;
   EXPECT_NE(out.find("replies True"), std::string::npos) << out;

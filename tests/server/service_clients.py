@@ -1,0 +1,73 @@
+#!/usr/bin/python3
+"""Clients that exercise a running `thaw serve`, shared by the service's tests (serve_load_test.cpp and
+the AddressSanitizer run, asan_service.sh).
+
+    service_clients.py PORT fuzz [smoke]
+
+fuzz: four clients send 6,000 random and malformed messages; then the server must still step and still
+refuse a bad command. smoke: a dryer change, a state save, a refused path. Each prints what it saw,
+one line per check ("... True" or the refusal code), which the caller checks.
+"""
+import asyncio, json, os, random, sys, websockets
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
+import thaw_client
+VALID = [{"type": "sim.pause"}, {"type": "sim.resume"}, {"type": "dryer.set", "dryer": 0, "on": True},
+         {"type": "camera.orbit", "d_azimuth": 5}, {"type": "view.set", "view": "particles"},
+         {"type": "quality.set", "width": 320, "height": 240}, {"type": "state.save", "name": "fz"},
+         {"type": "param.set", "path": "heat.time_scale", "value": 50}, {"type": "sim.step", "n": 2}]
+def mutate(rng):
+    m = dict(rng.choice(VALID))
+    kind = rng.randrange(7)
+    if kind == 0: return bytes(rng.randrange(256) for _ in range(rng.randrange(1, 200)))
+    if kind == 1: return json.dumps(m)[: rng.randrange(1, 30)]
+    if kind == 2: m[rng.choice(list(m))] = rng.choice([None, [], {}, "x" * 300, -1e308, 1e308, True, "../../etc"])
+    if kind == 3: m["type"] = rng.choice(["", "dryer", "sim.step.", "x" * 100, 7])
+    if kind == 4: return "x" * rng.choice([16 * 1024 + 1, 70000])
+    if kind == 5: m["extra" + str(rng.randrange(9))] = rng.random()
+    return json.dumps(m)
+async def fuzzer(PORT, seed, count):
+    rng = random.Random(seed)
+    async with websockets.connect(f"ws://127.0.0.1:{PORT}/", subprotocols=["thaw.v1"], max_size=None) as ws:
+        for _ in range(count):
+            await ws.send(mutate(rng))
+        # Drain what came back for a moment: errors and acks, never a closed socket.
+        replies = 0
+        try:
+            while True:
+                msg = await asyncio.wait_for(ws.recv(), 0.5)
+                replies += isinstance(msg, str)
+        except asyncio.TimeoutError:
+            pass
+        return replies
+async def fuzz(PORT):
+    replies = await asyncio.gather(*[fuzzer(PORT, seed, 1500) for seed in range(4)])
+    print("replies", all(r > 0 for r in replies))
+    async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/") as thaw:
+        await thaw.command("sim.resume")
+        before = (await thaw.stats())["steps"]
+        after = (await thaw.stats(lambda s: s["steps"] > before, timeout=30))["steps"]
+        print("still stepping", after > before)
+        try:
+            await thaw.command("dryer.set", dryer=0, speed=1000)
+        except thaw_client.CommandError as e:
+            print("still checking", e.code)
+
+async def smoke(PORT):
+    async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/") as thaw:
+        header = await thaw.frame()
+        print("frame", header[0]["width"] > 0)
+        await thaw.command("sim.resume")
+        await thaw.command("param.set", path="heat.time_scale", value=20)
+        await thaw.command("state.save", name="smoke")
+        try:
+            await thaw.command("state.load", name="../../etc/passwd")
+        except thaw_client.CommandError as e:
+            print("refused", e.code)
+
+
+if __name__ == "__main__":
+    port = int(sys.argv[1])
+    checks = {"fuzz": fuzz, "smoke": smoke}
+    for name in sys.argv[2:]:
+        asyncio.run(checks[name](port))
