@@ -44,6 +44,9 @@ int cmd_serve(int argc, char** argv) {
   // Looking down at 50 degrees shows what lies inside a glass or a tank, which the melting scenes have.
   RenderOptions view;
   view.elevation = 50.0;
+  // Fast surfaces keep the stream at 10+ frames a second on 2 cores (docs/RENDERING.md); a client can
+  // ask for full quality with quality.set.
+  view.quality = "fast";
   RenderWorker renderer(session, view, [&] {
     if (Service* s = service_ptr.load()) s->frame_ready();
   });

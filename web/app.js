@@ -208,6 +208,7 @@ $('dryer-speed').addEventListener('input', (e) => {
 });
 const sendView = () => send('view.set', { view: $('view-kind').value, colour_by: $('colour-by').value });
 $('view-kind').addEventListener('change', sendView);
+$('full-quality').addEventListener('change', (e) => send('quality.set', { surface: e.target.checked ? 'full' : 'fast' }));
 $('colour-by').addEventListener('change', sendView);
 
 connect();
