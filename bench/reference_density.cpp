@@ -17,7 +17,6 @@ using namespace reference;
 constexpr int kLanes = 8;
 constexpr float kPi = 3.14159265358979f;
 
-
 // Equation of state and the per-particle outputs, as at the end of density.cl.
 inline void finish(const ReferenceParticles& p, const ReferenceParams& k, std::size_t i, float rho,
                    ReferenceDensity& out) {
@@ -55,32 +54,24 @@ void scalar_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refe
                  ReferenceDensity& out) {
   const long n = static_cast<long>(p.size());
   const float H = k.H, H2 = H * H;
-  const int R = g.reach;
   const Float4* pos = p.pos.data();
   const std::uint32_t* cs = p.cell_start.data();
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) {
     const Float4 pi = pos[i];
-    const int cx = cell_of(pi[0], g.origin[0], g.inv_cell, g.nx);
-    const int cy = cell_of(pi[1], g.origin[1], g.inv_cell, g.ny);
-    const int cz = cell_of(pi[2], g.origin[2], g.inv_cell, g.nz);
     float rho = 0.0f;
-    for (int z = std::max(cz - R, 0); z <= std::min(cz + R, g.nz - 1); ++z)
-      for (int y = std::max(cy - R, 0); y <= std::min(cy + R, g.ny - 1); ++y) {
-        const int row = (z * g.ny + y) * g.nx;
-        const std::uint32_t jb = cs[row + std::max(cx - R, 0)];
-        const std::uint32_t je = cs[row + std::min(cx + R, g.nx - 1) + 1];
-        for (std::uint32_t j = jb; j < je; ++j) {
-          const float dx = pi[0] - pos[j][0], dy = pi[1] - pos[j][1], dz = pi[2] - pos[j][2];
-          const float r2 = dx * dx + dy * dy + dz * dz;
-          if (r2 < H2)
-            rho += pos[j][3] * (kWendland ? sph::wendland_c2_w(std::sqrt(r2), H) : sph::cubic_spline_w(std::sqrt(r2), H));
-        }
+    for_each_row(g, cs, pi[0], pi[1], pi[2], [&](std::uint32_t jb, std::uint32_t je) {
+      for (std::uint32_t j = jb; j < je; ++j) {
+        const float dx = pi[0] - pos[j][0], dy = pi[1] - pos[j][1], dz = pi[2] - pos[j][2];
+        const float r2 = dx * dx + dy * dy + dz * dz;
+        if (r2 < H2)
+          rho += pos[j][3] *
+                 (kWendland ? sph::wendland_c2_w(std::sqrt(r2), H) : sph::cubic_spline_w(std::sqrt(r2), H));
       }
+    });
     finish(p, k, static_cast<std::size_t>(i), rho, out);
   }
 }
-
 
 // W / sigma as a function of q = r / H (the lanes' factorised kernel, as in sim/kernels/density.cl).
 template <bool kWendland>
@@ -104,7 +95,6 @@ void lanes_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refer
   const long n = static_cast<long>(p.size());
   const float H = k.H, H2 = H * H, inv_H = 1.0f / H;
   const float sigma = kWendland ? 21.0f / (2.0f * kPi * H * H * H) : 8.0f / (kPi * H * H * H);
-  const int R = g.reach;
   const float* X = p.x.data();
   const float* Y = p.y.data();
   const float* Z = p.z.data();
@@ -114,23 +104,16 @@ void lanes_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refer
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) {
     const float px = X[i], py = Y[i], pz = Z[i];
-    const int cx = cell_of(px, g.origin[0], g.inv_cell, g.nx);
-    const int cy = cell_of(py, g.origin[1], g.inv_cell, g.ny);
-    const int cz = cell_of(pz, g.origin[2], g.inv_cell, g.nz);
     v8f acc = {};
-    for (int z = std::max(cz - R, 0); z <= std::min(cz + R, g.nz - 1); ++z)
-      for (int y = std::max(cy - R, 0); y <= std::min(cy + R, g.ny - 1); ++y) {
-        const int row = (z * g.ny + y) * g.nx;
-        const std::uint32_t jb = cs[row + std::max(cx - R, 0)];
-        const std::uint32_t je = cs[row + std::min(cx + R, g.nx - 1) + 1];
-        for (std::uint32_t j = jb; j < je; j += kLanes) {
-          const v8f dx = px - load8(X + j), dy = py - load8(Y + j), dz = pz - load8(Z + j);
-          const v8f r2 = dx * dx + dy * dy + dz * dz;
-          const v8i in = (lane_ids < static_cast<int>(je - j)) & (r2 < H2);
-          const v8f w = load8(M + j) * w_shape<kWendland>(sqrt8(r2) * inv_H);
-          acc += in ? w : v8f{};
-        }
+    for_each_row(g, cs, px, py, pz, [&](std::uint32_t jb, std::uint32_t je) {
+      for (std::uint32_t j = jb; j < je; j += kLanes) {
+        const v8f dx = px - load8(X + j), dy = py - load8(Y + j), dz = pz - load8(Z + j);
+        const v8f r2 = dx * dx + dy * dy + dz * dz;
+        const v8i in = (lane_ids < static_cast<int>(je - j)) & (r2 < H2);
+        const v8f w = load8(M + j) * w_shape<kWendland>(sqrt8(r2) * inv_H);
+        acc += in ? w : v8f{};
       }
+    });
     // The device's lane tree (lanes_sum8): ((0+4) + (1+5)) + ((2+6) + (3+7)).
     const float s0 = acc[0] + acc[4], s1 = acc[1] + acc[5], s2 = acc[2] + acc[6], s3 = acc[3] + acc[7];
     const float rho = sigma * ((s0 + s1) + (s2 + s3));
@@ -140,7 +123,8 @@ void lanes_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refer
 
 }  // namespace
 
-ReferenceParticles::ReferenceParticles(const std::vector<Float4>& position, const std::vector<std::uint8_t>& ph,
+ReferenceParticles::ReferenceParticles(const std::vector<Float4>& position,
+                                       const std::vector<std::uint8_t>& ph,
                                        const std::vector<std::uint32_t>& starts)
     : pos(position), phase(ph), cell_start(starts) {
   const std::size_t padded = pos.size() + 16;

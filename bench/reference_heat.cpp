@@ -17,7 +17,6 @@ using namespace reference;
 constexpr int kLanes = 8;
 constexpr float kPi = 3.14159265358979f;
 
-
 void resize(ReferenceHeat& out, std::size_t n) {
   out.q_conduction.resize(n);
   out.q_ambient.resize(n);
@@ -40,7 +39,6 @@ void scalar_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refe
                  const ReferenceHeatParams& k, ReferenceHeat& out) {
   const long n = static_cast<long>(p.size());
   const float H = k.H, H2 = H * H, eta2 = k.eta2, exposed_r2 = k.exposed_r2;
-  const int R = g.reach;
   const Float4* pos = p.pos.data();
   const float* T = t.T.data();
   const float* K = t.k.data();
@@ -49,35 +47,27 @@ void scalar_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refe
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) {
     const Float4 pi = pos[i];
-    const int cx = cell_of(pi[0], g.origin[0], g.inv_cell, g.nx);
-    const int cy = cell_of(pi[1], g.origin[1], g.inv_cell, g.ny);
-    const int cz = cell_of(pi[2], g.origin[2], g.inv_cell, g.nz);
     const float Ti = T[i], ki = K[i];
     float acc = 0.0f;
     int covered = 0;
-    for (int z = std::max(cz - R, 0); z <= std::min(cz + R, g.nz - 1); ++z)
-      for (int y = std::max(cy - R, 0); y <= std::min(cy + R, g.ny - 1); ++y) {
-        const int row = (z * g.ny + y) * g.nx;
-        const std::uint32_t jb = cs[row + std::max(cx - R, 0)];
-        const std::uint32_t je = cs[row + std::min(cx + R, g.nx - 1) + 1];
-        for (std::uint32_t j = jb; j < je; ++j) {
-          const float dx = pi[0] - pos[j][0], dy = pi[1] - pos[j][1], dz = pi[2] - pos[j][2];
-          const float r2 = dx * dx + dy * dy + dz * dz;
-          covered += r2 < exposed_r2 ? 1 : 0;  // as the device: not limited to the support
-          if (r2 < H2) {
-            const float kij = 2.0f * ki * K[j] / std::max(ki + K[j], 1e-30f);
-            const float r = std::sqrt(r2);
-            // x . grad W = grad_factor r^2
-            const float gf =
-                kWendland ? sph::wendland_c2_grad_factor(r, H) : sph::cubic_spline_grad_factor(r, H);
-            acc += V[j] * kij * (Ti - T[j]) * gf * r2 / (r2 + eta2);
-          }
+    for_each_row(g, cs, pi[0], pi[1], pi[2], [&](std::uint32_t jb, std::uint32_t je) {
+      for (std::uint32_t j = jb; j < je; ++j) {
+        const float dx = pi[0] - pos[j][0], dy = pi[1] - pos[j][1], dz = pi[2] - pos[j][2];
+        const float r2 = dx * dx + dy * dy + dz * dz;
+        covered += r2 < exposed_r2 ? 1 : 0;  // as the device: not limited to the support
+        if (r2 < H2) {
+          const float kij = 2.0f * ki * K[j] / std::max(ki + K[j], 1e-30f);
+          const float r = std::sqrt(r2);
+          // x . grad W = grad_factor r^2
+          const float gf =
+              kWendland ? sph::wendland_c2_grad_factor(r, H) : sph::cubic_spline_grad_factor(r, H);
+          acc += V[j] * kij * (Ti - T[j]) * gf * r2 / (r2 + eta2);
         }
       }
+    });
     finish(t, k, static_cast<std::size_t>(i), 2.0f * V[i] * acc, covered - 1, out);
   }
 }
-
 
 // grad_factor / (sigma / H^2) as a function of q = r / H (sim/kernels/sph_lanes.h).
 template <bool kWendland>
@@ -102,7 +92,6 @@ void lanes_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refer
   const long n = static_cast<long>(p.size());
   const float H = k.H, H2 = H * H, inv_H = 1.0f / H, eta2 = k.eta2, exposed_r2 = k.exposed_r2;
   const float sigma = kWendland ? 21.0f / (2.0f * kPi * H * H * H) : 8.0f / (kPi * H * H * H);
-  const int R = g.reach;
   const float* X = p.x.data();
   const float* Y = p.y.data();
   const float* Z = p.z.data();
@@ -115,31 +104,24 @@ void lanes_loop(const ReferenceParticles& p, const ReferenceGrid& g, const Refer
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < n; ++i) {
     const float px = X[i], py = Y[i], pz = Z[i];
-    const int cx = cell_of(px, g.origin[0], g.inv_cell, g.nx);
-    const int cy = cell_of(py, g.origin[1], g.inv_cell, g.ny);
-    const int cz = cell_of(pz, g.origin[2], g.inv_cell, g.nz);
     const float Ti = T[i], ki = K[i];
     v8f acc = {};
     v8i covered = {};
-    for (int z = std::max(cz - R, 0); z <= std::min(cz + R, g.nz - 1); ++z)
-      for (int y = std::max(cy - R, 0); y <= std::min(cy + R, g.ny - 1); ++y) {
-        const int row = (z * g.ny + y) * g.nx;
-        const std::uint32_t jb = cs[row + std::max(cx - R, 0)];
-        const std::uint32_t je = cs[row + std::min(cx + R, g.nx - 1) + 1];
-        for (std::uint32_t j = jb; j < je; j += kLanes) {
-          const v8f dx = px - load8(X + j), dy = py - load8(Y + j), dz = pz - load8(Z + j);
-          const v8f r2 = dx * dx + dy * dy + dz * dz;
-          const v8i lane = lane_ids < static_cast<int>(je - j);
-          const v8i in = lane & (r2 < H2);
-          const v8f kj = load8(K + j);
-          const v8f ksum = ki + kj;
-          const v8f kij = 2.0f * ki * kj / (ksum > tiny ? ksum : tiny);
-          const v8f term = load8(V + j) * kij * (Ti - load8(T + j)) *
-                           grad_shape<kWendland>(sqrt8(r2) * inv_H) * r2 / (r2 + eta2);
-          acc += in ? term : v8f{};
-          covered -= lane & (r2 < exposed_r2);  // masks are -1
-        }
+    for_each_row(g, cs, px, py, pz, [&](std::uint32_t jb, std::uint32_t je) {
+      for (std::uint32_t j = jb; j < je; j += kLanes) {
+        const v8f dx = px - load8(X + j), dy = py - load8(Y + j), dz = pz - load8(Z + j);
+        const v8f r2 = dx * dx + dy * dy + dz * dz;
+        const v8i lane = lane_ids < static_cast<int>(je - j);
+        const v8i in = lane & (r2 < H2);
+        const v8f kj = load8(K + j);
+        const v8f ksum = ki + kj;
+        const v8f kij = 2.0f * ki * kj / (ksum > tiny ? ksum : tiny);
+        const v8f term = load8(V + j) * kij * (Ti - load8(T + j)) * grad_shape<kWendland>(sqrt8(r2) * inv_H) *
+                         r2 / (r2 + eta2);
+        acc += in ? term : v8f{};
+        covered -= lane & (r2 < exposed_r2);  // masks are -1
       }
+    });
     // The device's lane tree (lanes_sum8): ((0+4) + (1+5)) + ((2+6) + (3+7)).
     const float s0 = acc[0] + acc[4], s1 = acc[1] + acc[5], s2 = acc[2] + acc[6], s3 = acc[3] + acc[7];
     int neighbours = -1;  // the particle itself is in its own range
