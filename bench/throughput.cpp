@@ -99,7 +99,7 @@ HeatComparison compare_heat(ClRuntime& cl, Solver& solver, const Scene& scene, c
                             const std::function<void()>& pause) {
   HeatComparison c;
   const auto& k = solver.constants();
-  const auto table = material_thermal_table(scene, k.rest_density, 1);  // wall layers: no wall heat here
+  const auto table = material_thermal_table(scene, k.rest_density);
   const float dt_heat = static_cast<float>(scene.heat.time_scale * solver.dt());
   const auto before = solver.particles();
   solver.compute_heat(solver.dt());

@@ -19,6 +19,7 @@
 #include "sim/particle_export.h"
 #include "sim/solver.h"
 #include "sim/state_file.h"
+#include "sim/thermal.h"
 
 namespace thaw {
 namespace {
@@ -97,10 +98,14 @@ int cmd_run(int argc, char** argv) {
   std::unique_ptr<MeshExporter> meshes;
   if (auto d = args.value("--export-mesh")) meshes = std::make_unique<MeshExporter>(*d, args.value("--mesh-format").value_or("obj"));
   std::uint64_t frame = 0;
-  auto picture = [&] {
+  // Particle exports, frames and meshes of one step share one read of the device.
+  auto outputs = [&] {
+    if (!exporter && !renderer && !meshes) return;
+    const HostParticles p = solver.particles();
+    const std::vector<float> temperature = temperatures_of(p, solver.scene());
+    if (exporter) exporter->write(p, solver.time(), temperature);
     if (!renderer && !meshes) return;
-    const RenderSnapshot snap =
-        make_snapshot(solver.particles(), solver.temperatures(), scene, solver.time(), solver.steps());
+    const RenderSnapshot snap = make_snapshot(p, temperature, solver.scene(), solver.time(), solver.steps());
     if (renderer) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%06llu.png", static_cast<unsigned long long>(frame));
@@ -144,17 +149,14 @@ int cmd_run(int argc, char** argv) {
     interval_timers = solver.timers();
   };
   write_metrics();
-  auto export_frame = [&] { exporter->write(solver.particles(), solver.time(), solver.temperatures()); };
-  if (exporter) export_frame();
-  picture();
+  outputs();
 
   const auto t0 = Clock::now();
   while (!done() && !g_stop) {
     solver.step();
     ++interval_steps;
     if ((solver.steps() - first_step) % std::uint64_t(every) == 0) {
-      if (exporter) export_frame();
-      picture();
+      outputs();
     }
     if (solver.time() >= next_output - 1e-12) {
       write_metrics();

@@ -15,7 +15,7 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
   std::size_t fluid = 0;
   m.heat = scene.heat.enabled && p.enthalpy.size() == p.size();
   std::vector<MaterialThermal> table;
-  if (m.heat) table = material_thermal_table(scene, rest_density, scene.wall_layers > 0 ? scene.wall_layers : 2);
+  if (m.heat) table = material_thermal_table(scene, rest_density);
   double t_sum = 0;
   std::size_t t_count = 0;
   m.min_temperature = std::numeric_limits<double>::infinity();

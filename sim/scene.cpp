@@ -85,10 +85,6 @@ int material_index(const Json& materials, const Json& name_value, const std::str
   throw SceneError(path, "unknown material '" + name + "'; defined: " + names_of(materials, ""));
 }
 
-double wall_layer_count(const Json& doc) {
-  const int layers = doc["domain"]["wall_layers"].get<int>();
-  return layers > 0 ? layers : std::ceil(doc["solver"]["support_ratio"].get<double>());
-}
 
 // Fluid lattices plus boundary particles: enough to stop a spacing typo, not a promise of the count.
 double estimated_particles(const Scene& s, double wall_layers) {
@@ -319,7 +315,7 @@ Scene convert_and_check(const Json& doc) {
                                               " m)");
   }
 
-  const double n = estimated_particles(s, wall_layer_count(doc));
+  const double n = estimated_particles(s, wall_layer_count(s));
   if (n > kMaxParticles) {
     throw SceneError("spacing", "about " + format_count(n) + " particles at " + format_number(s.spacing) +
                                     " m, more than the limit of " + format_count(kMaxParticles) +
@@ -351,6 +347,10 @@ std::string parse_reason(const std::string& what) {
 }
 
 }  // namespace
+
+int wall_layer_count(const Scene& s) {
+  return s.wall_layers > 0 ? s.wall_layers : static_cast<int>(std::ceil(s.solver.support_ratio - 1e-9));
+}
 
 SolverSettings solver_settings_from_json(const Json& j) {
   SolverSettings s;

@@ -135,6 +135,10 @@ struct Scene {
   Json source;  // the validated document with every default filled in
 };
 
+// Layers of particles in the domain walls and sampled solids: domain.wall_layers, or enough to fill the
+// kernel support.
+int wall_layer_count(const Scene& s);
+
 // Loads a scene file: reads, applies `--set` overrides, validates, converts.
 // Throws SceneError (with a JSON path) or Error (missing/unreadable file).
 Scene load_scene(const std::string& file, const std::vector<std::string>& overrides = {});

@@ -26,10 +26,6 @@ void lattice(const Vec3& min, const Vec3& max, double dx, F&& visit) {
       for (int i = 0; i < n.x(); ++i) visit(Vec3(min + dx * Vec3(i + 0.5, j + 0.5, k + 0.5)));
 }
 
-int layer_count(const Scene& s) {
-  return s.wall_layers > 0 ? s.wall_layers : static_cast<int>(std::ceil(s.solver.support_ratio - 1e-9));
-}
-
 void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase, int material, double enthalpy) {
   p.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
   const float hi = static_cast<float>(enthalpy);
@@ -46,7 +42,7 @@ void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase
 HostParticles sample_scene(const Scene& scene) {
   HostParticles p;
   const double dx = scene.spacing;
-  const int layers = layer_count(scene);
+  const int layers = wall_layer_count(scene);
   const double depth = layers * dx;
 
   // Boundary particles first; their mass (Psi) is left 0 for the solver to compute.

@@ -130,8 +130,7 @@ SolverConstants derive_constants(const Scene& scene) {
   for (const Material& m : scene.materials) {
     if (m.kind != "solid") k.exposed_capacity = std::min(k.exposed_capacity, m.density * m.specific_heat * dx / 6.0);
     if (m.wall_heat) {
-      const double layers = scene.wall_layers > 0 ? scene.wall_layers : std::ceil(s.support_ratio - 1e-9);
-      k.wall_dt = std::min(k.wall_dt, 0.5 * m.density * m.specific_heat * dx * layers /
+      k.wall_dt = std::min(k.wall_dt, 0.5 * m.density * m.specific_heat * dx * wall_layer_count(scene) /
                                           (scene.heat.time_scale * scene.heat.wall_coefficient));
     }
   }
@@ -286,9 +285,7 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   enthalpy_ = buf(n * 8);
   spare_enthalpy_ = buf(n * 8);
   if (heat_) {
-    const int layers = scene.wall_layers > 0 ? scene.wall_layers
-                                             : static_cast<int>(std::ceil(scene.solver.support_ratio - 1e-9));
-    table_ = material_thermal_table(scene, k_.rest_density, layers);
+    table_ = material_thermal_table(scene, k_.rest_density);
     materials_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table_.size() * sizeof(MaterialThermal),
                             table_.data());
     thermal_ = buf(std::size_t(stride_) * 3 * 4);
@@ -748,12 +745,8 @@ double Solver::total_enthalpy() const {
 }
 
 std::vector<float> Solver::temperatures() const {
-  std::vector<float> out(n_, 0.0f);
-  if (!heat_ || n_ == 0) return out;
-  const HostParticles p = particles();
-  for (std::size_t i = 0; i < n_; ++i)
-    out[i] = static_cast<float>(temperature_at(table_[p.material[i]], double(p.enthalpy[i][0]) + p.enthalpy[i][1]));
-  return out;
+  if (!heat_ || n_ == 0) return std::vector<float>(n_, 0.0f);
+  return temperatures_of(particles(), scene_);
 }
 
 std::uint64_t Solver::clamped() const {

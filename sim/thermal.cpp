@@ -7,24 +7,50 @@
 
 namespace thaw {
 
-std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density, int wall_layers) {
+namespace {
+
+// The thermal law of one material: specific heats on each side of the melting point, latent heat and
+// melting point. An ice and the fluid it melts into share L and T_m, and each side's c is the c of the
+// material that is on that side; materials without a phase change have L = 0 and T_m = 0.
+struct Law {
+  double c_solid, c_liquid, latent = 0, melt = 0;
+  bool ice = false;
+};
+
+Law law_of(const Scene& scene, int material) {
+  const Material& m = scene.materials[static_cast<std::size_t>(material)];
+  Law law{m.specific_heat, m.specific_heat};
+  if (m.partner >= 0) {
+    const Material& other = scene.materials[static_cast<std::size_t>(m.partner)];
+    law.ice = m.kind == "ice";
+    law.c_solid = law.ice ? m.specific_heat : other.specific_heat;
+    law.c_liquid = law.ice ? other.specific_heat : m.specific_heat;
+    law.latent = m.latent_heat;
+    law.melt = m.melting_point;
+  }
+  return law;
+}
+
+}  // namespace
+
+std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density) {
   std::vector<MaterialThermal> table;
   const double dx = scene.spacing;
-  for (const Material& m : scene.materials) {
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    const Law law = law_of(scene, static_cast<int>(i));
     MaterialThermal t{};
     t.k_solid = t.k_liquid = static_cast<float>(m.conductivity);
-    t.c_solid = t.c_liquid = static_cast<float>(m.specific_heat);
+    t.c_solid = static_cast<float>(law.c_solid);
+    t.c_liquid = static_cast<float>(law.c_liquid);
+    t.latent = static_cast<float>(law.latent);
+    t.melt = static_cast<float>(law.melt);
     t.partner = m.partner;
     if (m.partner >= 0) {
       const Material& other = scene.materials[static_cast<std::size_t>(m.partner)];
-      const bool ice = m.kind == "ice";
-      t.c_solid = static_cast<float>(ice ? m.specific_heat : other.specific_heat);
-      t.c_liquid = static_cast<float>(ice ? other.specific_heat : m.specific_heat);
-      t.k_solid = static_cast<float>(ice ? m.conductivity : other.conductivity);
-      t.k_liquid = static_cast<float>(ice ? other.conductivity : m.conductivity);
-      t.latent = static_cast<float>(m.latent_heat);
-      t.melt = static_cast<float>(m.melting_point);
-      t.flags |= ice ? THAW_MAT_MELTS : THAW_MAT_FREEZES;
+      t.k_solid = static_cast<float>(law.ice ? m.conductivity : other.conductivity);
+      t.k_liquid = static_cast<float>(law.ice ? other.conductivity : m.conductivity);
+      t.flags |= law.ice ? THAW_MAT_MELTS : THAW_MAT_FREEZES;
     }
     // Fluid particles carry their physical mass; static ones (solids, ice) the rest-density mass rho0 V
     // that the fluid solver needs from a boundary particle.
@@ -32,12 +58,13 @@ std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double r
     if (m.kind != "solid") t.flags |= THAW_MAT_AIR_EXCHANGE;
     if (m.held) {
       t.flags |= THAW_MAT_HELD;
-      t.held_enthalpy = static_cast<float>(m.specific_heat * (m.held_temperature - t.melt));
+      t.held_enthalpy = static_cast<float>(enthalpy_at(scene, static_cast<int>(i), m.held_temperature));
     }
     if (m.wall_heat) {
       // U A (T_out - T) through the outer face, shared by the layers of wall behind each dx^2 of it.
       t.flags |= THAW_MAT_WALL_HEAT;
-      t.wall_coefficient = static_cast<float>(scene.heat.wall_coefficient * dx * dx / std::max(wall_layers, 1));
+      t.wall_coefficient =
+          static_cast<float>(scene.heat.wall_coefficient * dx * dx / std::max(wall_layer_count(scene), 1));
       t.wall_temperature = static_cast<float>(scene.heat.wall_temperature);
     }
     table.push_back(t);
@@ -46,31 +73,21 @@ std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double r
 }
 
 double enthalpy_at(const Scene& scene, int material, double temperature) {
-  const Material& m = scene.materials[static_cast<std::size_t>(material)];
-  if (m.partner < 0) return m.specific_heat * temperature;  // T_m = 0 for materials without a phase change
-  const Material& other = scene.materials[static_cast<std::size_t>(m.partner)];
-  const bool ice = m.kind == "ice";
-  const double c_solid = ice ? m.specific_heat : other.specific_heat;
-  const double c_liquid = ice ? other.specific_heat : m.specific_heat;
-  const double dT = temperature - m.melting_point;
-  return ice ? c_solid * dT : m.latent_heat + c_liquid * dT;
+  const Law law = law_of(scene, material);
+  // Ice is on its solid side at its melting point; everything else on its liquid side.
+  return thermal::thermal_enthalpy(temperature, law.ice ? 0 : 1, law.latent, law.melt, law.c_solid, law.c_liquid);
 }
 
 double temperature_at(const MaterialThermal& m, double h) {
-  return h < 0 ? m.melt + h / m.c_solid : (h > m.latent ? m.melt + (h - m.latent) / m.c_liquid : m.melt);
+  return thermal::thermal_temperature(h, m.latent, m.melt, m.c_solid, m.c_liquid);
 }
 
-double liquid_fraction_at(const MaterialThermal& m, double h) {
-  if (m.latent <= 0) return h > 0 ? 1.0 : 0.0;
-  return std::clamp(h / m.latent, 0.0, 1.0);
-}
+double liquid_fraction_at(const MaterialThermal& m, double h) { return thermal::thermal_liquid_fraction(h, m.latent); }
 
 std::vector<float> temperatures_of(const HostParticles& p, const Scene& scene) {
   std::vector<float> out;
   if (!scene.heat.enabled || p.enthalpy.size() != p.size()) return out;
-  const int layers = scene.wall_layers > 0 ? scene.wall_layers
-                                           : static_cast<int>(std::ceil(scene.solver.support_ratio - 1e-9));
-  const auto table = material_thermal_table(scene, derive_constants(scene).rest_density, layers);
+  const auto table = material_thermal_table(scene, derive_constants(scene).rest_density);
   out.reserve(p.size());
   for (std::size_t i = 0; i < p.size(); ++i)
     out.push_back(static_cast<float>(

@@ -13,13 +13,13 @@ using thermal::MaterialThermal;
 
 // One entry per Scene::materials, in order; rest_density is the fluid's rho0, which sets the SPH mass
 // of static particles (solids and ice carry rho0 V, their physical mass is rho V).
-std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density, int wall_layers);
+std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density);
 
 // Specific enthalpy [J/kg] of a particle of `material` at temperature T [°C] (ice below or at its melting
 // point is solid, everything else is on its liquid side).
 double enthalpy_at(const Scene& scene, int material, double temperature);
 
-// Temperature [°C] and liquid fraction from a particle's enthalpy.
+// Temperature [°C] and liquid fraction from a particle's enthalpy (thermal_law.h, in double).
 double temperature_at(const MaterialThermal& m, double enthalpy);
 double liquid_fraction_at(const MaterialThermal& m, double enthalpy);
 

@@ -13,11 +13,14 @@
 #ifndef THAW_THERMAL_LAW_H
 #define THAW_THERMAL_LAW_H
 
+/* The conversions run in float on the device and in double on the host (metrics, sampling, tests). */
 #ifdef __OPENCL_VERSION__
 #define THAW_TL_FN
+#define THAW_TL_REAL float
 #else
 #include <cstdint>
 #define THAW_TL_FN inline
+#define THAW_TL_REAL double
 namespace thaw::thermal {
 #endif
 
@@ -42,13 +45,15 @@ typedef struct {
   unsigned int flags;       /* THAW_MAT_* */
 } MaterialThermal;
 
-THAW_TL_FN float thermal_temperature(float h, float latent, float melt, float c_solid, float c_liquid) {
-  return h < 0.0f ? melt + h / c_solid : (h > latent ? melt + (h - latent) / c_liquid : melt);
+THAW_TL_FN THAW_TL_REAL thermal_temperature(THAW_TL_REAL h, THAW_TL_REAL latent, THAW_TL_REAL melt,
+                                            THAW_TL_REAL c_solid, THAW_TL_REAL c_liquid) {
+  return h < 0 ? melt + h / c_solid : (h > latent ? melt + (h - latent) / c_liquid : melt);
 }
 
 /* The enthalpy of the solid (liquid = 0) or the liquid (liquid = 1) at T; at T_m the solid has h = 0
  * and the liquid h = L. */
-THAW_TL_FN float thermal_enthalpy(float T, int liquid, float latent, float melt, float c_solid, float c_liquid) {
+THAW_TL_FN THAW_TL_REAL thermal_enthalpy(THAW_TL_REAL T, int liquid, THAW_TL_REAL latent, THAW_TL_REAL melt,
+                                         THAW_TL_REAL c_solid, THAW_TL_REAL c_liquid) {
   return liquid ? latent + c_liquid * (T - melt) : c_solid * (T - melt);
 }
 
@@ -69,8 +74,8 @@ THAW_TL_FN float thermal_conductivity(float h, float latent, float k_solid, floa
 }
 
 /* For materials that change phase; 0 or 1 otherwise. */
-THAW_TL_FN float thermal_liquid_fraction(float h, float latent) {
-  return latent > 0.0f ? (h <= 0.0f ? 0.0f : (h >= latent ? 1.0f : h / latent)) : (h > 0.0f ? 1.0f : 0.0f);
+THAW_TL_FN THAW_TL_REAL thermal_liquid_fraction(THAW_TL_REAL h, THAW_TL_REAL latent) {
+  return latent > 0 ? (h <= 0 ? 0 : (h >= latent ? 1 : h / latent)) : (h > 0 ? 1 : 0);
 }
 
 #ifndef __OPENCL_VERSION__
@@ -78,4 +83,5 @@ static_assert(sizeof(MaterialThermal) == 48, "MaterialThermal must match its Ope
 }  // namespace thaw::thermal
 #endif
 #undef THAW_TL_FN
+#undef THAW_TL_REAL
 #endif

@@ -122,7 +122,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
 
   // The front as the converted volume per area: each slab particle holds dx^3 and converts by its
   // liquid fraction f (melting) or 1 - f (freezing).
-  const auto table = material_thermal_table(scene, rho, 1);
+  const auto table = material_thermal_table(scene, rho);
   const HostParticles q = solver.particles();
   double converted = 0;
   for (std::size_t i = 0; i < q.size(); ++i) {

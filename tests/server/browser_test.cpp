@@ -16,7 +16,9 @@ using testing::ServedScene;
 using testing::TempDir;
 
 TEST(BrowserClient, LoadsStreamsAndAimsADryerInHeadlessChromium) {
-  if (!std::filesystem::exists("/usr/bin/chromium")) GTEST_SKIP() << "Debian's chromium is not installed";
+  // scripts/debian-packages.txt lists chromium, so scripts/setup installs it: its absence is a broken
+  // set-up, not a reason to pass.
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium")) << "Debian's chromium is not installed (scripts/setup)";
   TempDir dir("browser");
   ServedScene served(dir, "default --state-dir states");
   ASSERT_GT(served.port(), 0) << served.log();

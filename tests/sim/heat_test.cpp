@@ -277,7 +277,7 @@ TEST(ThermalLaw, EnthalpyAndTemperatureInvertAcrossTheMeltingPoint) {
   Json doc = isolated_scene();
   doc["ice"] = {{{"material", "ice"}, {"box", box(0, 0, 0, 0.01, 0.01, 0.01)}}};
   const Scene scene = scene_from_json(doc);
-  const auto table = material_thermal_table(scene, 1000, 2);
+  const auto table = material_thermal_table(scene, 1000);
   const int water = 0, ice = 1;
   for (double T : {-40.0, -1.0, 0.0}) EXPECT_NEAR(temperature_at(table[ice], enthalpy_at(scene, ice, T)), T, 1e-9);
   for (double T : {0.0, 1.0, 90.0}) EXPECT_NEAR(temperature_at(table[water], enthalpy_at(scene, water, T)), T, 1e-9);
