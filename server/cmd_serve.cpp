@@ -2,6 +2,8 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <exception>
+#include <optional>
 #include <thread>
 
 #include "server/cli_args.h"
@@ -9,11 +11,16 @@
 #include "server/render_worker.h"
 #include "server/service.h"
 #include "server/session.h"
+#include "server/thread_priority.h"
 #include "server/ws_server.h"
 #include "sim/error.h"
 
 namespace thaw {
 namespace {
+
+// How much lower the simulation's threads run than the render thread's (nice steps; 5 gives the
+// renderer about three times the simulation's share of a contended core).
+constexpr int kSimulationNice = 5;
 
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
@@ -38,8 +45,24 @@ int cmd_serve(int argc, char** argv) {
   if (!service_options.loopback && service_options.token.empty())
     throw Error("--host " + net.host + ": serving beyond 127.0.0.1 needs --token TOKEN (clients without it watch)");
 
-  ClRuntime cl(args.value("--device").value_or(""));
-  Session session(cl, scene, args.sets(), args.value("--state-dir").value_or("thaw-states"));
+  // Frames go ahead of steps: a picture that answers a command within 200 ms matters more to someone
+  // steering than the last few steps a second. The OpenCL runtime starts in a thread at a lower
+  // priority, so a CPU driver's workers (pocl's) inherit it, and the simulation thread runs there too;
+  // the render thread and its rasteriser's workers keep the normal priority.
+  std::optional<ClRuntime> cl;
+  const std::string device = args.value("--device").value_or("");
+  std::exception_ptr failed;
+  std::thread([&] {
+    try {
+      lower_this_thread_priority(kSimulationNice);
+      cl.emplace(device);
+    } catch (...) {
+      failed = std::current_exception();
+    }
+  }).join();
+  if (failed) std::rethrow_exception(failed);
+  Session session(*cl, scene, args.sets(), args.value("--state-dir").value_or("thaw-states"));
+  session.set_thread_nice(kSimulationNice);
   std::atomic<Service*> service_ptr{nullptr};
   // Looking down at 50 degrees shows what lies inside a glass or a tank, which the melting scenes have.
   RenderOptions view;

@@ -74,10 +74,14 @@ void RenderWorker::run() {
     double fps = 30;
     {
       std::unique_lock lock(mutex_);
-      cv_.wait(lock, [&] { return stop_ || snapshot_pending_ || options_version_ != drawn_version; });
+      cv_.wait(lock, [&] {
+        return stop_ || ((snapshot_pending_ || options_version_ != drawn_version) && (watched_ || frames_ == 0));
+      });
       // The fps cap: changes that arrive meanwhile merge into the next frame instead of queueing.
-      if (!stop_ && Clock::now() < next_allowed) cv_.wait_until(lock, next_allowed, [&] { return stop_; });
+      if (!stop_ && !hurry_ && Clock::now() < next_allowed)
+        cv_.wait_until(lock, next_allowed, [&] { return stop_ || hurry_; });
       if (stop_) break;
+      hurry_ = false;
       snapshot_pending_ = false;
       drawn_version = options_version_;
       options = options_;
@@ -148,6 +152,8 @@ bool RenderWorker::render_one(const std::shared_ptr<const RenderSnapshot>& snaps
     {
       std::lock_guard lock(frame_mutex_);
       frame_ = std::move(frame);
+      finished_.push_back(Clock::now());
+      while (finished_.size() > 256) finished_.pop_front();
       picked_snapshot_ = snapshot;
       picked_fields_ = fields;
       picked_camera_ = camera;
@@ -286,6 +292,32 @@ int RenderWorker::jpeg_quality() const {
 double RenderWorker::fps_cap() const {
   std::lock_guard lock(mutex_);
   return fps_;
+}
+
+void RenderWorker::hurry() {
+  {
+    std::lock_guard lock(mutex_);
+    hurry_ = true;
+  }
+  cv_.notify_all();
+}
+
+void RenderWorker::set_watched(bool watched) {
+  {
+    std::lock_guard lock(mutex_);
+    watched_ = watched;
+  }
+  cv_.notify_all();
+}
+
+double RenderWorker::fps() const {
+  constexpr double window_s = 2.0;
+  const auto now = Clock::now();
+  std::lock_guard lock(frame_mutex_);
+  const auto from = now - std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(window_s));
+  std::size_t n = 0;
+  for (const auto t : finished_) n += t >= from;
+  return double(n) / window_s;
 }
 
 // ---- picking -------------------------------------------------------------------------------------------

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -67,6 +68,12 @@ class RenderWorker {
   RenderOptions options() const;
   int jpeg_quality() const;
   double fps_cap() const;
+  // The next frame starts without waiting for the fps cap: someone waits to see a command's effect.
+  void hurry();
+  // Whether anyone receives frames; unwatched, the worker draws only its first frame (for picking).
+  void set_watched(bool watched);
+  // Frames finished per second over the last two seconds.
+  double fps() const;
 
   // ---- what the worker publishes (thread-safe) -----------------------------------------------------
   std::shared_ptr<const EncodedFrame> latest_frame() const;
@@ -99,7 +106,11 @@ class RenderWorker {
   std::condition_variable cv_;
   RenderOptions options_;
   int jpeg_quality_ = 80;
-  double fps_ = 30.0;
+  // 12 frames a second: above the 10 a moving picture needs, and on 2 cores it leaves the simulation
+  // most of the time between frames (a client can ask for up to 60 with quality.set).
+  double fps_ = 12.0;
+  bool hurry_ = false;
+  bool watched_ = true;
   std::uint64_t options_version_ = 1;
   bool snapshot_pending_ = true;  // the session published since the last frame began
   bool stop_ = false;
@@ -108,6 +119,7 @@ class RenderWorker {
 
   // Published frame, and what pick() needs of it.
   mutable std::mutex frame_mutex_;
+  std::deque<std::chrono::steady_clock::time_point> finished_;  // when recent frames were done, for fps()
   mutable std::condition_variable frame_cv_;
   std::shared_ptr<const EncodedFrame> frame_;
   std::shared_ptr<const RenderSnapshot> picked_snapshot_;

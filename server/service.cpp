@@ -45,6 +45,8 @@ Json dryers_json(const Scene& s) {
 Service::Service(Session& session, RenderWorker& renderer, ServiceOptions options)
     : session_(session), renderer_(renderer), options_(std::move(options)) {
   subscription_ = session_.subscribe([this] { on_published(); });
+  // Nobody connected: no frames to draw, so the simulation gets the whole machine.
+  renderer_.set_watched(false);
 }
 
 Service::~Service() { session_.unsubscribe(subscription_); }
@@ -80,11 +82,13 @@ void Service::on_open(std::uint64_t client, const std::string&) {
   // Without a token, a server that only loopback clients can reach gives everyone control.
   clients_.emplace(client, Client{options_.token.empty() && options_.loopback,
                                   protocol::RateLimiter(options_.command_rate, options_.command_burst)});
+  renderer_.set_watched(true);
 }
 
 void Service::on_close(std::uint64_t client) {
   std::lock_guard lock(mutex_);
   clients_.erase(client);
+  renderer_.set_watched(!clients_.empty());
 }
 
 void Service::on_oversize(std::uint64_t client, std::size_t bytes) {
@@ -96,18 +100,35 @@ void Service::on_oversize(std::uint64_t client, std::size_t bytes) {
 void Service::on_text(std::uint64_t client, std::string_view message) {
   using namespace protocol;
   bool controller = false;
+  const auto parsed = parse(message);  // bounded: the loop refuses messages over kMaxMessageBytes
+  // Frame acknowledgements come with every frame and cost nothing: they are not counted as commands.
+  if (const auto* r = std::get_if<Request>(&parsed)) {
+    if (const auto* ack = std::get_if<FrameAck>(&r->command)) {
+      if (server_) server_->ack_frame(client, ack->frame);
+      return;
+    }
+  }
   {
     std::lock_guard lock(mutex_);
     const auto it = clients_.find(client);
     if (it == clients_.end()) return;
     if (!it->second.limiter.allow(now_s())) {
-      reply(client, error(ErrorCode::RateLimited, "more than " + std::to_string(int(options_.command_rate)) +
-                                                      " commands a second; slow down"));
+      std::optional<Json> id;
+      std::string type;
+      if (const auto* r = std::get_if<Request>(&parsed)) {
+        id = r->id;
+        type = type_name(r->command);
+      } else {
+        id = std::get<ParseError>(parsed).id;
+        type = std::get<ParseError>(parsed).type;
+      }
+      reply(client, error(ErrorCode::RateLimited,
+                          "more than " + std::to_string(int(options_.command_rate)) + " commands a second; slow down",
+                          id, type));
       return;
     }
     controller = it->second.controller;
   }
-  const auto parsed = parse(message);
   if (const auto* e = std::get_if<ParseError>(&parsed)) {
     reply(client, error(e->code, e->message, e->id, e->type));
     return;
@@ -132,6 +153,8 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
   }
   const auto id = r.id;
   auto done = [this, client, id, type](std::optional<ErrorCode> code, std::string msg, Json result) {
+    // A command has changed what the picture shows: draw it now rather than at the next fps slot.
+    if (!code) renderer_.hurry();
     if (code) {
       reply(client, error(*code, msg, id, type));
     } else {
@@ -145,7 +168,7 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
       [&](const auto& c) {
         using T = std::decay_t<decltype(c)>;
         if constexpr (std::is_same_v<T, FrameAck>) {
-          if (server_) server_->ack_frame(client, c.frame);
+          // answered above, before the rate limit
         } else if constexpr (std::is_same_v<T, CameraSet>) {
           renderer_.set_camera(c.azimuth, c.elevation, c.distance, c.target, c.fov);
           done({}, "", Json::object());
@@ -157,7 +180,13 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
           done({}, "", Json::object());
         } else if constexpr (std::is_same_v<T, QualitySet>) {
           renderer_.set_quality(c.width, c.height, c.jpeg_quality, c.fps, c.surface);
-          done({}, "", Json::object());
+          const RenderOptions now = renderer_.options();
+          done({}, "",
+               {{"width", now.width},
+                {"height", now.height},
+                {"jpeg_quality", renderer_.jpeg_quality()},
+                {"fps", renderer_.fps_cap()},
+                {"surface", now.quality}});
         } else if constexpr (std::is_same_v<T, DryerAim>) {
           const auto hit = renderer_.pick(c.x, c.y);
           if (!hit)
@@ -188,6 +217,7 @@ void Service::on_published() {
     s["frame"] = f->frame;
     s["render_ms"] = f->render_ms;
     s["encode_ms"] = f->encode_ms;
+    s["fps"] = renderer_.fps();
   }
   s["dryers"] = dryers_json(*session_.scene());
   server_->broadcast_text(s.dump());

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <future>
 
+#include "server/thread_priority.h"
 #include "sim/error.h"
 #include "sim/metrics.h"
 #include "sim/solver.h"
@@ -211,6 +212,7 @@ void Session::unsubscribe(int id) {
 // ---- the simulation thread -----------------------------------------------------------------------------
 
 void Session::run() {
+  lower_this_thread_priority(thread_nice_);
   reanchor();
   last_publish_ = Clock::now();
   window_start_steps_ = solver_->steps();
@@ -315,7 +317,15 @@ void Session::apply_pending(std::deque<Pending>& batch) {
       // the command's failure, not the service's.
       o = {ErrorCode::Failed, e.what(), Json::object()};
     }
-    if (!deferred) answers.push_back({std::move(p.done), std::move(o)});
+    if (deferred) continue;
+    // Every ack says at which simulated time and step the command took effect: a frame whose header
+    // time is at or after it shows the change (the stream's latency is measured from there).
+    if (!o.code && (o.result.is_object() || o.result.is_null()) && !o.result.contains("time")) {
+      if (o.result.is_null()) o.result = Json::object();
+      const Json when = time_result();
+      for (const auto& [key, value] : when.items()) o.result[key] = value;
+    }
+    answers.push_back({std::move(p.done), std::move(o)});
   }
   // Answer after publishing, so a client that sees the ack and then reads the stats sees its change.
   if (dirty_) publish();

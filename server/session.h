@@ -45,6 +45,8 @@ class Session {
   // machine holds for the whole service. Throws SceneError / Error like load_scene and the Solver.
   Session(ClRuntime& cl, std::string scene_name, std::vector<std::string> overrides, std::string state_dir);
   ~Session();  // stops
+  // Before start(): the simulation thread lowers its own priority by this many nice steps.
+  void set_thread_nice(int steps) { thread_nice_ = steps; }
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
 
@@ -85,6 +87,7 @@ class Session {
   void unsubscribe(int id);  // after it returns, that callback is not running and never runs again
 
   // How often the session publishes at most while it steps [Hz].
+  int thread_nice_ = 0;
   static constexpr double kPublishRate = 60.0;
 
  private:

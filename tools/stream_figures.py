@@ -1,14 +1,14 @@
 #!/usr/bin/python3
 """Streaming figures of a running `thaw serve`: frames per second with one viewer and with ten, and the
-time from a dryer command to the first frame drawn from a simulated time at or after it.
+time from sending a dryer command to the arrival of the first frame drawn from the simulated time at
+which the command took effect (its ack says when) or later.
 
-    tools/stream_figures.py ws://127.0.0.1:8080/ [--fast]
-
-The command's simulated time is taken from the next stats event after its ack (stats come at most ten
-times a second), so the latency includes up to 100 ms of that wait and overstates the true delay.
+    tools/stream_figures.py ws://127.0.0.1:8080/ [--fast] [--tries N]
 """
+import argparse
 import asyncio
 import os
+import statistics
 import sys
 import time
 
@@ -17,41 +17,58 @@ import thaw_client
 
 
 async def viewer(url, seconds):
+    """Frames per second this viewer receives, and the simulation's steps per second meanwhile."""
     async with thaw_client.connect(url) as thaw:
         await thaw.frame()
+        s0 = await thaw.stats()
         t0, frames = time.time(), 0
         while time.time() - t0 < seconds:
             await thaw.frame()
             frames += 1
-        return frames / (time.time() - t0)
+        s1 = await thaw.stats()
+        wall = time.time() - t0
+        return frames / wall, (s1["steps"] - s0["steps"]) / wall
 
 
-async def latencies(url, tries=5):
+async def latencies(url, tries):
     out = []
     async with thaw_client.connect(url) as thaw:
         await thaw.frame()
         for k in range(tries):
-            t0 = time.time()
-            await thaw.command("dryer.set", dryer=0, on=(k % 2 == 0))
-            t_command = (await thaw.stats())["time"]
-            while (await thaw.frame())[0]["time"] < t_command:
-                pass
-            out.append(time.time() - t0)
+            t0 = time.monotonic()
+            ack = await thaw.command("dryer.set", dryer=0, on=(k % 2 == 0))
+            header, _ = await thaw.frame_from(ack["time"])
+            out.append(header["received"] - t0)
             await asyncio.sleep(0.3)
     return out
 
 
-async def main(url, fast):
-    async with thaw_client.connect(url) as thaw:
-        await thaw.command("quality.set", surface="fast" if fast else "full")
-    print("surface quality", "fast" if fast else "full")
-    print("1 viewer: %.1f frames/s" % await viewer(url, 8))
-    rates = await asyncio.gather(*[viewer(url, 8) for _ in range(10)])
-    print("10 viewers: " + " ".join("%.1f" % r for r in rates) + " frames/s")
-    print("dryer command to frame: " + " ".join("%.0f" % (1000 * x) for x in await latencies(url)) + " ms")
+def summary(latencies_s):
+    ms = sorted(1000 * x for x in latencies_s)
+    return "median %.0f ms, max %.0f ms (%s)" % (statistics.median(ms), ms[-1], " ".join("%.0f" % x for x in ms))
 
+
+async def main(url, fast, tries, fps):
+    async with thaw_client.connect(url) as thaw:
+        ack = await thaw.command("quality.set", surface="fast" if fast else "full", **fps)
+    print("surface quality %s, frame rate cap %g/s" % (ack["surface"], ack["fps"]))
+    fps, steps = await viewer(url, 8)
+    print("1 viewer: %.1f frames/s; simulation %.0f steps/s" % (fps, steps))
+    print("1 viewer: dryer command to frame: " + summary(await latencies(url, tries)))
+    # Ten clients: nine watch while the tenth (also a viewer) sends the commands and times them.
+    watchers = [asyncio.create_task(viewer(url, 8 + 0.5 * tries)) for _ in range(9)]
+    await asyncio.sleep(1)
+    timed = await latencies(url, tries)
+    rates = await asyncio.gather(*watchers)
+    print("10 viewers: " + " ".join("%.1f" % r[0] for r in rates) + " frames/s (the nine watchers); "
+          "simulation %.0f steps/s" % statistics.mean(r[1] for r in rates))
+    print("10 viewers: dryer command to frame: " + summary(timed))
 
 if __name__ == "__main__":
-    if len(sys.argv) < 2:
-        sys.exit("usage: stream_figures.py ws://HOST:PORT/ [--fast]")
-    asyncio.run(main(sys.argv[1], "--fast" in sys.argv[2:]))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("url", help="ws://HOST:PORT/ of a running thaw serve")
+    parser.add_argument("--fast", action="store_true", help="ask for fast surface quality first")
+    parser.add_argument("--tries", type=int, default=10, help="dryer commands timed per case")
+    parser.add_argument("--fps", type=float, help="ask for this frame rate cap first")
+    args = parser.parse_args()
+    asyncio.run(main(args.url, args.fast, args.tries, {"fps": args.fps} if args.fps else {}))

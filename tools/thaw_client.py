@@ -17,10 +17,12 @@ each JSON command and prints the server's reply to it (as `thaw ctl` does).
 """
 
 import asyncio
+import collections
 import contextlib
 import json
 import struct
 import sys
+import time as _time
 
 import websockets
 
@@ -42,6 +44,7 @@ class Thaw:
         self.welcome = None
         self.latest_stats = None
         self.latest_frame = None  # (header dict, JPEG bytes)
+        self._recent_frames = collections.deque(maxlen=8)
         self._next_id = 1
         self._replies = {}
         self._stats_waiters = []
@@ -54,8 +57,10 @@ class Thaw:
                 magic, frame, time, width, height, length = FRAME_HEADER.unpack_from(message)
                 if magic != b"THF1":
                     continue
-                header = {"frame": frame, "time": time, "width": width, "height": height}
+                header = {"frame": frame, "time": time, "width": width, "height": height,
+                          "received": _time.monotonic()}
                 self.latest_frame = (header, message[FRAME_HEADER.size:FRAME_HEADER.size + length])
+                self._recent_frames.append(self.latest_frame)
                 await self.ws.send(json.dumps({"type": "frame.ack", "frame": frame}))
                 for waiter in self._frame_waiters:
                     if not waiter.done():
@@ -118,6 +123,17 @@ class Thaw:
         future = asyncio.get_running_loop().create_future()
         self._frame_waiters.append(future)
         return await asyncio.wait_for(future, timeout)
+
+    async def frame_from(self, sim_time, timeout=30):
+        """The first frame drawn from simulated time sim_time or later (an ack's `time` says when a
+        command took effect), whether it has already arrived or not. Its header's `received` is the
+        time.monotonic() at which it arrived."""
+        deadline = _time.monotonic() + timeout
+        while True:
+            for f in self._recent_frames:
+                if f[0]["time"] >= sim_time:
+                    return f
+            await self.frame(max(0.0, deadline - _time.monotonic()))
 
     async def save_frame(self, path, timeout=30):
         header, jpeg = await self.frame(timeout)

@@ -26,7 +26,12 @@ async def main():
         header = await thaw.save_frame("frame.jpg")
         print("frame", header["width"], header["height"])
         first = await thaw.stats()
-        await thaw.command("dryer.set", dryer=0, on=True, temperature=150, speed=25)
+        ack = await thaw.command("dryer.set", dryer=0, on=True, temperature=150, speed=25)
+        shown, _ = await thaw.frame_from(ack["time"])
+        print("frame shows the command", shown["time"] >= ack["time"] and ack["steps"] >= first["steps"])
+        print("frame rate in stats", (await thaw.stats(lambda s: s.get("fps", 0) > 0))["fps"] > 0)
+        q = await thaw.command("quality.set", fps=20, jpeg_quality=70)
+        print("quality", q["width"], q["height"], q["fps"], q["jpeg_quality"], q["surface"])
         later = await thaw.stats(lambda s: s["ice_mass"] < first["ice_mass"] * 0.995, timeout=150)
         print("ice mass fell", later["ice_mass"] < first["ice_mass"])
         print("closure", abs(later["energy"]["closure_relative"]) < 1e-6)
@@ -43,6 +48,9 @@ asyncio.run(main())
   EXPECT_EQ(client_status, 0) << out;
   EXPECT_NE(out.find("role controller dryers 1"), std::string::npos) << out;
   EXPECT_NE(out.find("frame 640 480"), std::string::npos) << out;
+  EXPECT_NE(out.find("frame shows the command True"), std::string::npos) << out;
+  EXPECT_NE(out.find("frame rate in stats True"), std::string::npos) << out;
+  EXPECT_NE(out.find("quality 640 480 20.0 70 fast"), std::string::npos) << out;
   EXPECT_NE(out.find("ice mass fell True"), std::string::npos) << out;
   EXPECT_NE(out.find("closure True"), std::string::npos) << out;
   EXPECT_NE(out.find("refused bad_field"), std::string::npos) << out;
@@ -77,6 +85,40 @@ TEST(ServeCtl, SendsCommandsAndPrintsTheReplies) {
   const auto gone = testing::run_thaw("ctl " + url + " '{\"type\": \"sim.pause\"}' --timeout 5", dir);
   EXPECT_EQ(gone.exit_code, 2) << gone.out;
   EXPECT_NE(gone.err.find(url), std::string::npos) << gone.err;
+}
+
+}  // namespace
+}  // namespace thaw
+
+namespace thaw {
+namespace {
+
+// The token bucket stops a command flood, but not frame acknowledgements, which come with every frame.
+TEST(ServeRateLimit, FloodsAreRefusedButFrameAcksAreNotCounted) {
+  TempDir dir("serve-rate");
+  ServedScene served(dir, "ice-on-plate --set spacing=0.006");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int client_status = 0;
+  const std::string out = served.run_python(R"(import asyncio, json, thaw_client
+async def main():
+    async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/") as thaw:
+        burst = thaw.welcome["limits"]["command_burst"]
+        for k in range(int(3 * burst)):
+            await thaw.ws.send(json.dumps({"type": "frame.ack", "frame": k}))
+        ack = await thaw.command("view.set", view="surface")
+        print("after acks", ack["type"])
+        replies = [thaw.send({"type": "view.set", "view": "surface"}) for _ in range(int(2 * burst))]
+        kinds = [r.get("code", r["type"]) for r in await asyncio.gather(*replies)]
+        print("flood", kinds.count("ack") >= burst - 1, kinds.count("rate_limited") > 0)
+        await asyncio.sleep(1.5)
+        print("later", (await thaw.command("view.set", view="surface"))["type"])
+asyncio.run(main())
+)", 60, &client_status);
+  EXPECT_TRUE(served.stop()) << served.log();
+  EXPECT_EQ(client_status, 0) << out;
+  EXPECT_NE(out.find("after acks ack"), std::string::npos) << out;
+  EXPECT_NE(out.find("flood True True"), std::string::npos) << out;
+  EXPECT_NE(out.find("later ack"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "server/render_worker.h"
+#include "server/thread_priority.h"
 #include "sim/error.h"
 #include "tests/test_support.h"
 
@@ -99,6 +100,10 @@ TEST_F(SessionTest, DryerSetMergesIntoTheDryerAndRefusesBadValues) {
   EXPECT_EQ(s->scene()->dryers[0].speed, 20.0);
   EXPECT_EQ(s->scene()->dryers[0].temperature, 80.0);
   EXPECT_EQ(s->scene()->dryers[0].half_angle, half_angle);  // fields left out keep their value
+  // The ack says when the change took effect: a frame drawn from that time on shows it.
+  ASSERT_TRUE(r.result.contains("time") && r.result.contains("steps")) << r.result.dump();
+  EXPECT_GE(r.result["time"].get<double>(), 0.0);
+  EXPECT_LE(r.result["time"].get<double>(), (*s->latest_stats())["time"].get<double>());
 
   protocol::DryerSet fast;
   fast.speed = 250.0;
@@ -338,6 +343,55 @@ TEST_F(RenderWorkerTest, RendersNumberedJpegFramesAndPicksTheIce) {
   EXPECT_EQ(jpeg_size(resized->jpeg), std::make_pair(96, 64));
   w.stop();
   s.stop();
+}
+
+TEST_F(RenderWorkerTest, UnwatchedDrawsOnlyItsFirstFrameAndHurrySkipsTheFpsCap) {
+  Session s(cl(), "ice-on-plate", {"spacing=0.006"}, (dir_.path() / "states").string());
+  s.start();
+  RenderWorker w(s);
+  w.set_view("particles");  // CPU-drawn: this test is about scheduling, not EGL
+  w.set_quality(64, 48, std::nullopt, 60.0, std::nullopt);
+  w.set_watched(false);
+  w.start();
+  auto first = w.wait_for_frame(0, 30s);
+  ASSERT_TRUE(first) << w.status();
+  EXPECT_EQ(first->frame, 1u);
+  // Nobody watches: the simulation keeps publishing, but no further frame is drawn.
+  const std::uint64_t seq = s.sequence();
+  s.wait_for_sequence(seq + 3, 5s);
+  EXPECT_GT(s.sequence(), seq);
+  EXPECT_EQ(w.wait_for_frame(first->frame, 500ms)->frame, 1u);
+
+  // Watched again, at one frame a second: after a frame, the next waits for its slot unless hurried.
+  w.set_quality(std::nullopt, std::nullopt, std::nullopt, 1.0, std::nullopt);
+  w.set_watched(true);
+  auto next = w.wait_for_frame(first->frame, 30s);
+  ASSERT_TRUE(next);
+  EXPECT_EQ(w.wait_for_frame(next->frame, 300ms)->frame, next->frame);  // within its one-second slot
+  auto slot = w.wait_for_frame(next->frame, 30s);  // the cap's frame comes after the slot
+  ASSERT_TRUE(slot && slot->frame > next->frame);
+  w.hurry();
+  auto hurried = w.wait_for_frame(slot->frame, 700ms);  // well inside the one-second slot
+  ASSERT_TRUE(hurried);
+  EXPECT_GT(hurried->frame, slot->frame);  // (on timeout it would be the slot's frame again)
+  EXPECT_GT(w.fps(), 0.0);
+  w.stop();
+  s.stop();
+}
+
+TEST(ThreadPriority, LoweredForThisThreadAndInheritedByItsThreads) {
+  const int before = this_thread_nice();
+  int lowered = 0, child = 0;
+  bool ok = false;
+  std::thread([&] {
+    ok = lower_this_thread_priority(3);
+    lowered = this_thread_nice();
+    std::thread([&] { child = this_thread_nice(); }).join();
+  }).join();
+  if (!ok) GTEST_SKIP() << "this system refuses to change a thread's nice value";
+  EXPECT_EQ(lowered, std::min(before + 3, 19));
+  EXPECT_EQ(child, lowered);           // e.g. an OpenCL CPU driver's workers started from that thread
+  EXPECT_EQ(this_thread_nice(), before);  // the other threads keep theirs
 }
 
 }  // namespace
