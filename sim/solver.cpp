@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "sim/cl_grid.h"
 #include "sim/error.h"
 #include "sim/kernels/dryer_model.h"
 #include "sim/photons.h"
@@ -15,14 +16,6 @@ namespace thaw {
 namespace {
 
 static_assert(static_cast<int>(Phase::Solid) == 2, "THAW_PHASE_SOLID in sim/kernels/grid_common.h");
-
-// Must match `Grid` in sim/kernels/grid_common.h.
-struct ClGrid {
-  cl_float4 origin;
-  cl_float4 inv_cell;
-  cl_int nx, ny, nz;
-};
-static_assert(sizeof(ClGrid) == 48, "ClGrid must match the OpenCL struct's layout");
 
 // Cells of H / kGridReach. A finer grid visits fewer candidates per neighbour but walks more, shorter
 // rows; with the neighbour loops on SIMD lanes, cells of H (9 rows of about 24 candidates) were the
