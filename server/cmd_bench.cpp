@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "bench/accuracy.h"
+#include "bench/bodies_bench.h"
 #include "bench/render_bench.h"
 #include "bench/throughput.h"
 #include "server/cli_args.h"
@@ -33,7 +34,7 @@ std::vector<T> list_of(const std::string& text, const char* option) {
 }  // namespace
 
 int cmd_bench(int argc, char** argv) {
-  if (argc < 3) throw Error("bench needs a kind: throughput, accuracy or render");
+  if (argc < 3) throw Error("bench needs a kind: throughput, accuracy, render or bodies");
   const std::string kind = argv[2];
   if (kind == "throughput") {
     CliArgs args(argc, argv, 3, {"--sizes", "--steps", "--device"}, {"--json"});
@@ -74,7 +75,25 @@ int cmd_bench(int argc, char** argv) {
     if (args.flag("--json")) std::printf("%s\n", r.dump(2).c_str());
     return 0;
   }
-  throw Error("unknown bench '" + kind + "' (throughput, accuracy, render)");
+  if (kind == "bodies") {
+    CliArgs args(argc, argv, 3, {"--size", "--radius", "--reps", "--device"}, {"--json"});
+    BodiesBenchOptions o;
+    const long long size = args.integer("--size", static_cast<long long>(o.particles));
+    if (size < 1000) throw Error("--size: must be >= 1000 particles");
+    o.particles = static_cast<std::size_t>(size);
+    if (auto r = args.value("--radius")) {
+      const auto v = list_of<double>(*r, "--radius");
+      if (v.size() != 1) throw Error("--radius: expected one value [particle spacings]");
+      o.radius = v[0];
+    }
+    o.reps = static_cast<int>(args.integer("--reps", o.reps));
+    if (o.reps < 1) throw Error("--reps: must be >= 1");
+    ClRuntime cl(args.value("--device").value_or(""));
+    const Json r = bench_bodies(cl, o, !args.flag("--json"));
+    if (args.flag("--json")) std::printf("%s\n", r.dump(2).c_str());
+    return 0;
+  }
+  throw Error("unknown bench '" + kind + "' (throughput, accuracy, render, bodies)");
 }
 
 }  // namespace thaw

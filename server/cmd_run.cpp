@@ -37,15 +37,17 @@ Json stage_ms(const StageTimers& t, std::uint64_t steps) {
 }  // namespace
 
 int cmd_run(int argc, char** argv) {
-  std::vector<std::string> with_value = {"--until",  "--steps",       "--metrics",     "--export",
-                                         "--every",  "--state-out",   "--state-in",    "--device",
+  std::vector<std::string> with_value = {"--until",  "--steps",       "--metrics",    "--export",
+                                         "--every",  "--state-out",   "--state-in",   "--device",
                                          "--frames", "--export-mesh", "--mesh-format"};
   for (const char* o : kRenderValueOptions) with_value.emplace_back(o);
   CliArgs args(argc, argv, 2, with_value, {"--quiet", "--no-progress"});
-  if (args.positional().size() > 1) throw Error("run takes one scene, got " + std::to_string(args.positional().size()));
+  if (args.positional().size() > 1)
+    throw Error("run takes one scene, got " + std::to_string(args.positional().size()));
   const bool has_scene = !args.positional().empty();
   const auto state_in = args.value("--state-in");
-  if (!has_scene && !state_in) throw Error("run needs a SCENE (a name in configs/ or a file), or --state-in FILE");
+  if (!has_scene && !state_in)
+    throw Error("run needs a SCENE (a name in configs/ or a file), or --state-in FILE");
   if (!args.value("--until") && !args.value("--steps")) throw Error("run needs --until SECONDS or --steps N");
   if (args.value("--until") && args.value("--steps")) throw Error("give either --until or --steps, not both");
 
@@ -56,8 +58,8 @@ int cmd_run(int argc, char** argv) {
     if (has_scene) {
       scene = load_scene(args.positional()[0], args.sets());
       if (scene.source.dump() != start.scene_json)
-        std::fprintf(stderr, "note: scene differs from the one stored in %s; continuing with %s\n", state_in->c_str(),
-                     args.positional()[0].c_str());
+        std::fprintf(stderr, "note: scene differs from the one stored in %s; continuing with %s\n",
+                     state_in->c_str(), args.positional()[0].c_str());
     } else {
       scene = scene_from_json(Json::parse(start.scene_json), args.sets());
     }
@@ -96,7 +98,8 @@ int cmd_run(int argc, char** argv) {
     renderer = std::make_unique<FrameRenderer>(render);
   }
   std::unique_ptr<MeshExporter> meshes;
-  if (auto d = args.value("--export-mesh")) meshes = std::make_unique<MeshExporter>(*d, args.value("--mesh-format").value_or("obj"));
+  if (auto d = args.value("--export-mesh"))
+    meshes = std::make_unique<MeshExporter>(*d, args.value("--mesh-format").value_or("obj"));
   std::uint64_t frame = 0;
   // Particle exports, frames and meshes of one step share one read of the device.
   auto outputs = [&] {
@@ -117,9 +120,9 @@ int cmd_run(int argc, char** argv) {
 
   const auto counts = solver.particles();
   if (!quiet)
-    std::printf("thaw run: scene '%s', %zu particles (water %zu, ice %zu, solid %zu) on %s\n", scene.name.c_str(),
-                solver.size(), counts.count(Phase::Water), counts.count(Phase::Ice), counts.count(Phase::Solid),
-                cl.description().c_str());
+    std::printf("thaw run: scene '%s', %zu particles (water %zu, ice %zu, solid %zu) on %s\n",
+                scene.name.c_str(), solver.size(), counts.count(Phase::Water), counts.count(Phase::Ice),
+                counts.count(Phase::Solid), cl.description().c_str());
   std::fflush(stdout);
 
   std::signal(SIGINT, on_signal);
@@ -129,7 +132,8 @@ int cmd_run(int argc, char** argv) {
   const std::uint64_t last_step = first_step + static_cast<std::uint64_t>(std::max(0LL, steps_wanted));
   const bool by_time = args.value("--until").has_value();
   auto done = [&] { return by_time ? solver.time() >= until : solver.steps() >= last_step; };
-  Progress progress(by_time ? until : double(last_step), by_time ? "s" : "steps", !quiet && !args.flag("--no-progress"));
+  Progress progress(by_time ? until : double(last_step), by_time ? "s" : "steps",
+                    !quiet && !args.flag("--no-progress"));
 
   const double interval = scene.solver.output_interval;
   double next_output = (std::floor(solver.time() / interval + 1e-9) + 1.0) * interval;
@@ -138,10 +142,12 @@ int cmd_run(int argc, char** argv) {
   StageTimers interval_timers;
   auto write_metrics = [&] {
     if (!metrics) return;
-    const double wall_ms = interval_steps ? 1e3 * seconds_since(interval_start) / double(interval_steps) : 0.0;
+    const double wall_ms =
+        interval_steps ? 1e3 * seconds_since(interval_start) / double(interval_steps) : 0.0;
     StageTimers diff;
     for (int s = 0; s < static_cast<int>(Stage::Count); ++s)
-      diff.add(static_cast<Stage>(s), solver.timers().seconds(static_cast<Stage>(s)) - interval_timers.seconds(static_cast<Stage>(s)));
+      diff.add(static_cast<Stage>(s), solver.timers().seconds(static_cast<Stage>(s)) -
+                                          interval_timers.seconds(static_cast<Stage>(s)));
     *metrics << metrics_json(measure(solver), wall_ms, stage_ms(diff, interval_steps)).dump() << '\n';
     metrics->flush();
     interval_steps = 0;
@@ -167,7 +173,9 @@ int cmd_run(int argc, char** argv) {
   const double wall = seconds_since(t0);
   progress.finish();
   if (interval_steps) write_metrics();
-  if (g_stop) std::fprintf(stderr, "thaw run: interrupted at step %llu; finishing outputs\n", (unsigned long long)solver.steps());
+  if (g_stop)
+    std::fprintf(stderr, "thaw run: interrupted at step %llu; finishing outputs\n",
+                 (unsigned long long)solver.steps());
   if (auto f = args.value("--state-out")) write_state_file(*f, solver.state());
 
   if (!quiet) {
@@ -182,19 +190,29 @@ int cmd_run(int argc, char** argv) {
       std::printf("stages, ms per step:");
       const auto& t = solver.timers();
       for (int s = 0; s < static_cast<int>(Stage::Count); ++s)
-        std::printf("  %s %.3f (%.0f%%)", kStageNames[s], 1e3 * t.seconds(static_cast<Stage>(s)) / double(steps),
+        std::printf("  %s %.3f (%.0f%%)", kStageNames[s],
+                    1e3 * t.seconds(static_cast<Stage>(s)) / double(steps),
                     100.0 * t.seconds(static_cast<Stage>(s)) / std::max(t.total(), 1e-12));
     }
-    std::printf("\nfinal: dt %.3g s, max speed %.4g m/s, density error max %.3g %% mean %.3g %%, fluid mass %.9g kg, "
-                "clamped %llu, kinetic %.4g J\n",
-                m.dt, m.max_speed, 100 * m.max_density_error, 100 * m.mean_density_error, m.fluid_mass,
-                (unsigned long long)m.clamped, m.kinetic);
+    std::printf(
+        "\nfinal: dt %.3g s, max speed %.4g m/s, density error max %.3g %% mean %.3g %%, fluid mass %.9g kg, "
+        "clamped %llu, kinetic %.4g J\n",
+        m.dt, m.max_speed, 100 * m.max_density_error, 100 * m.mean_density_error, m.fluid_mass,
+        (unsigned long long)m.clamped, m.kinetic);
     if (m.heat) {
       const EnergyBudget& b = m.budget;
-      std::printf("heat: ice %.6g kg, water %.6g kg, temperature %.4g..%.4g °C (mean %.4g); heat in %.6g J "
-                  "(ambient %.4g, lamps %.4g, dryers %.4g, walls %.4g, held %.4g), energy closure %.3g J\n",
-                  m.ice_mass, m.water_mass, m.min_temperature, m.max_temperature, m.mean_temperature, b.heat_in(),
-                  b.ambient, b.lamps, b.dryers, b.walls, b.held, m.closure());
+      std::printf(
+          "heat: ice %.6g kg, water %.6g kg, temperature %.4g..%.4g °C (mean %.4g); heat in %.6g J "
+          "(ambient %.4g, lamps %.4g, dryers %.4g, walls %.4g, held %.4g), energy closure %.3g J\n",
+          m.ice_mass, m.water_mass, m.min_temperature, m.max_temperature, m.mean_temperature, b.heat_in(),
+          b.ambient, b.lamps, b.dryers, b.walls, b.held, m.closure());
+    }
+    if (!m.bodies.is_null()) {
+      int free = 0, fixed = 0;
+      for (const auto& b : m.bodies["list"]) (b["fixed"].get<bool>() ? fixed : free)++;
+      std::printf("ice bodies: %d free, %d fixed; %llu labellings (last %d sweeps)\n", free, fixed,
+                  (unsigned long long)m.bodies["labellings"].get<std::uint64_t>(),
+                  m.bodies["last_sweeps"].get<int>());
     }
   }
   return g_stop ? 130 : 0;

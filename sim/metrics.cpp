@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/rigid_ice.h"
 #include "sim/solver.h"
 #include "sim/thermal.h"
 
@@ -68,7 +69,25 @@ Metrics measure(const Solver& s) {
   m.steps = s.steps();
   m.clamped = s.clamped();
   m.budget = s.energy_budget();
+  m.bodies = bodies_json(s);
   return m;
+}
+
+Json bodies_json(const Solver& s) {
+  const RigidIce* rigid = s.rigid_ice();
+  if (!rigid) return nullptr;
+  auto vec = [](const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); };
+  Json list = Json::array();
+  for (const IceBody& b : rigid->bodies()) {
+    list.push_back({{"label", b.label},
+                    {"particles", b.particles},
+                    {"mass", b.body.mass},
+                    {"fixed", b.body.fixed},
+                    {"centre", vec(b.body.position)},
+                    {"velocity", vec(b.body.velocity)},
+                    {"angular_velocity", vec(b.body.angular_velocity())}});
+  }
+  return {{"list", list}, {"labellings", rigid->labellings()}, {"last_sweeps", rigid->last_iterations()}};
 }
 
 Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_ms_per_step) {
@@ -87,12 +106,13 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
   j["mean_density_error"] = m.mean_density_error;
   j["total_mass"] = m.heat ? m.water_mass + m.ice_mass : m.fluid_mass;
   j["energy"] = {{"kinetic", m.kinetic}, {"potential", m.potential}, {"mechanical", m.kinetic + m.potential}};
+  if (!m.bodies.is_null()) j["bodies"] = m.bodies;
   if (m.heat) {
     const EnergyBudget& b = m.budget;
     j["mass"] = {{"water", m.water_mass}, {"ice", m.ice_mass}};
     j["temperature"] = {{"min", m.min_temperature}, {"mean", m.mean_temperature}, {"max", m.max_temperature}};
-    const double gross = std::abs(b.ambient) + std::abs(b.lamps) + std::abs(b.dryers) + std::abs(b.walls) +
-                         std::abs(b.held);
+    const double gross =
+        std::abs(b.ambient) + std::abs(b.lamps) + std::abs(b.dryers) + std::abs(b.walls) + std::abs(b.held);
     j["heat"] = {
         {"enthalpy", m.enthalpy},
         {"in",

@@ -14,18 +14,24 @@ struct Metrics {
   double max_speed = 0;          // over moving particles [m/s]
   double max_density_error = 0;  // max (rho - rho0) / rho0 over fluid particles (compression)
   double mean_density_error = 0;
-  double fluid_mass = 0;         // [kg], summed in double
-  double kinetic = 0;            // [J]
-  double potential = 0;          // [J], -sum m g.x
+  double fluid_mass = 0;  // [kg], summed in double
+  double kinetic = 0;     // [J]
+  double potential = 0;   // [J], -sum m g.x
   // Heat (scenes with heat.enabled): physical masses, temperatures over ice and water, and the budget.
   bool heat = false;
-  double water_mass = 0, ice_mass = 0;  // [kg]
+  double water_mass = 0, ice_mass = 0;                                    // [kg]
   double min_temperature = 0, mean_temperature = 0, max_temperature = 0;  // [°C]
-  double enthalpy = 0;            // total sum m h [J]
-  double enthalpy_scale = 0;      // sum m |h| [J]: the size round-off is measured against
+  double enthalpy = 0;                                                    // total sum m h [J]
+  double enthalpy_scale = 0;  // sum m |h| [J]: the size round-off is measured against
   EnergyBudget budget;
   double closure() const { return enthalpy - budget.initial - budget.heat_in(); }
+  // Rigid ice (scenes with free ice): one object per body (label, particles, mass, fixed, centre,
+  // velocity, angular velocity) and the labelling counters; null otherwise.
+  Json bodies;
 };
+
+// The bodies of a solver's rigid ice as Metrics::bodies writes them (null without rigid ice).
+Json bodies_json(const Solver& solver);
 
 Metrics measure(const HostParticles& p, const Scene& scene, double rest_density);
 Metrics measure(const Solver& solver);

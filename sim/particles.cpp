@@ -32,6 +32,7 @@ void HostParticles::resize(std::size_t n) {
   material.resize(n);
   id.resize(n);
   enthalpy.resize(n);
+  anchored.resize(n);
 }
 
 std::size_t HostParticles::count(Phase p) const {

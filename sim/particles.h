@@ -27,6 +27,8 @@ struct HostParticles {
   // Specific enthalpy [J/kg] as a compensated pair (hi, lo), h = hi + lo: small heat increments on a
   // large enthalpy (latent heat is 334 kJ/kg) would otherwise be rounded away step after step.
   std::vector<Float2> enthalpy;
+  // 1 for ice held in place (an ice entry with motion "fixed"), 0 for every other particle.
+  std::vector<std::uint8_t> anchored;
 
   std::size_t size() const { return position.size(); }
   void resize(std::size_t n);

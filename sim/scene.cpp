@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "sim/error.h"
+#include "sim/geometry/mesh.h"
 
 namespace thaw {
 
@@ -90,13 +91,15 @@ int material_index(const Json& materials, const Json& name_value, const std::str
 double estimated_particles(const Scene& s, double wall_layers) {
   const double h = s.spacing;
   const Eigen::Vector3d extent = s.domain.max - s.domain.min;
+  auto lattice_count = [h](const Box& b) { return ((b.max - b.min) / h).array().floor().prod(); };
   double n = 0.0;
-  for (const FluidBlock& f : s.fluids) n += ((f.box.max - f.box.min) / h).array().floor().prod();
-  for (const IceBlock& f : s.ice) n += ((f.box.max - f.box.min) / h).array().floor().prod();
+  for (const FluidBlock& f : s.fluids) n += lattice_count(f.box);
+  for (const IceBlock& f : s.ice)
+    n += f.shape.axis_aligned_box() ? lattice_count(f.box) : f.shape.volume() / (h * h * h);
   const double face_area[3] = {extent.y() * extent.z(), extent.x() * extent.z(), extent.x() * extent.y()};
   for (const std::string& side : s.walls) n += face_area[side[1] - 'x'] * wall_layers / (h * h);
   for (const Solid& solid : s.solids) {
-    if (solid.shape == Solid::Shape::Plane) {
+    if (solid.plane) {
       n += *std::max_element(face_area, face_area + 3) * wall_layers / (h * h);
     } else {
       const Eigen::Vector3d e = solid.box.max - solid.box.min;
@@ -107,8 +110,83 @@ double estimated_particles(const Scene& s, double wall_layers) {
   return n;
 }
 
+bool listed(const std::vector<std::string>& items, const std::string& item) {
+  return std::find(items.begin(), items.end(), item) != items.end();
+}
+
+// "'sphere', 'cylinder' or 'cone'"
+std::string one_of(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == items.size() ? " or " : ", ") + ("'" + items[i] + "'");
+  return out;
+}
+
+// The fields that several shapes share are optional in the schema; here they are held to their shapes.
+void check_shared_shape_fields(const Json& entry, const std::string& path) {
+  const std::string shape = entry["shape"].get<std::string>();
+  for (const SharedShapeField& f : shared_shape_fields()) {
+    const bool wanted = listed(f.shapes, shape);
+    if (entry.contains(f.key) && !wanted)
+      throw SceneError(join_path(path, f.key), "only allowed when shape is " + one_of(f.shapes));
+    if (!entry.contains(f.key) && wanted && f.required)
+      throw SceneError(join_path(path, f.key), "missing: required when shape is '" + shape + "'");
+  }
+}
+
+// A mesh file: as written when absolute, else in the scene's folder, else in configs/ of the source tree.
+std::string resolve_mesh_path(const std::string& name, const std::string& folder, const std::string& path) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> candidates = {fs::path(name)};
+  if (!fs::path(name).is_absolute())
+    candidates = {fs::path(folder) / name, fs::path(THAW_SOURCE_DIR) / "configs" / name};
+  std::string looked;
+  for (const fs::path& p : candidates) {
+    std::error_code ec;
+    const fs::path full = fs::absolute(p, ec).lexically_normal();
+    if (fs::exists(full, ec)) return full.string();
+    if (looked.find(full.string()) == std::string::npos)
+      looked += (looked.empty() ? "" : ", ") + full.string();
+  }
+  throw SceneError(path, "mesh file '" + name + "' not found; looked for " + looked);
+}
+
+// The shape of an ice or solid entry that has passed validation (any shape but "plane"). A mesh's path
+// is replaced in `entry` by the file it was found at, so the scene's source reloads from anywhere.
+Shape shape_of(Json& entry, const std::string& path, const std::string& folder) {
+  check_shared_shape_fields(entry, path);
+  const std::string kind = entry["shape"].get<std::string>();
+  const Eigen::Matrix3d rotation = entry.contains("rotation") ? rotation_from_degrees(vec(entry["rotation"]))
+                                                              : Eigen::Matrix3d::Identity();
+  if (kind == "box") {
+    const Box b = box(entry["box"]);
+    check_box(b, path + ".box", "empty box");
+    return Shape::box(b.min, b.max, rotation);
+  }
+  if (kind == "sphere") return Shape::sphere(vec(entry["centre"]), entry["radius"].get<double>());
+  if (kind == "mesh") {
+    const std::string file = resolve_mesh_path(entry["mesh"].get<std::string>(), folder, path + ".mesh");
+    entry["mesh"] = file;
+    try {
+      return Shape::mesh(
+          place_mesh(load_mesh(file), rotation, vec(entry["centre"]), entry["size"].get<double>()));
+    } catch (const Error& e) {
+      throw SceneError(path + ".mesh", e.what());
+    }
+  }
+  const Eigen::Vector3d from = vec(entry["from"]), to = vec(entry["to"]);
+  if (from == to) throw SceneError(path + ".to", "equals from: the " + kind + " has no length");
+  const double radius = entry["radius"].get<double>();
+  if (kind == "cylinder") return Shape::cylinder(from, to, radius);
+  if (kind == "cone") return Shape::cone(from, to, radius);
+  return Shape::capsule(from, to, radius);
+}
+
+Box box_of(const Shape& shape) { return {shape.bounds().min(), shape.bounds().max()}; }
+
 // Checks that span several fields; `doc` has passed validation, so every field is present and typed.
-Scene convert_and_check(const Json& doc) {
+// `folder` is where relative mesh paths are looked for first.
+Scene convert_and_check(Json doc, const std::string& folder) {
   Scene s;
   s.name = doc["name"].get<std::string>();
   s.description = doc["description"].get<std::string>();
@@ -221,15 +299,16 @@ Scene convert_and_check(const Json& doc) {
   }
 
   for (std::size_t i = 0; i < doc["ice"].size(); ++i) {
-    const Json& f = doc["ice"][i];
+    Json& f = doc["ice"][i];
     const std::string path = join_path("ice", i);
     IceBlock block;
     block.material = material_index(materials, f["material"], path + ".material", "ice", "an ice block");
-    block.box = box(f["box"]);
+    block.shape = shape_of(f, path, folder);
+    block.box = box_of(block.shape);
+    block.motion = f["motion"] == "free" ? IceBlock::Motion::Free : IceBlock::Motion::Fixed;
     const double melt = s.materials[static_cast<std::size_t>(block.material)].melting_point;
     block.temperature = temperature_of(f, std::min(ambient, melt));
-    check_box(block.box, path + ".box", "empty box");
-    check_inside(s.domain, block.box, path + ".box");
+    check_inside(s.domain, block.box, block.shape.axis_aligned_box() ? path + ".box" : path);
     check_start(block.material, block.temperature, path + ".temperature");
     s.ice.push_back(block);
   }
@@ -237,16 +316,16 @@ Scene convert_and_check(const Json& doc) {
     throw SceneError("fluids", "the scene has neither fluid nor ice: add a block to fluids or ice");
 
   for (std::size_t i = 0; i < doc["solids"].size(); ++i) {
-    const Json& j = doc["solids"][i];
+    Json& j = doc["solids"][i];
     const std::string path = join_path("solids", i);
     Solid solid;
     solid.material = material_index(materials, j["material"], path + ".material", "solid", "a solid");
-    if (j["shape"] == "box") {
-      solid.shape = Solid::Shape::Box;
-      solid.box = box(j["box"]);
-      check_box(solid.box, path + ".box", "empty box");
+    if (j["shape"] != "plane") {
+      solid.shape = shape_of(j, path, folder);
+      solid.box = box_of(solid.shape);
     } else {
-      solid.shape = Solid::Shape::Plane;
+      check_shared_shape_fields(j, path);
+      solid.plane = true;
       solid.point = vec(j["point"]);
       solid.normal = vec(j["normal"]);
       if (solid.normal.norm() == 0.0) throw SceneError(path + ".normal", "must not be zero");
@@ -325,7 +404,7 @@ Scene convert_and_check(const Json& doc) {
     throw SceneError("solver.min_dt", format_number(s.solver.min_dt) + " s must be below solver.max_dt (" +
                                           format_number(s.solver.max_dt) + " s)");
   }
-  s.source = doc;
+  s.source = std::move(doc);
   return s;
 }
 
@@ -399,10 +478,10 @@ void apply_override(Json& doc, const std::string& assignment, const Field& schem
   set_at_path(doc, path, std::move(value), &schema);
 }
 
-Scene scene_from_json(Json doc, const std::vector<std::string>& overrides) {
+Scene scene_from_json(Json doc, const std::vector<std::string>& overrides, const std::string& folder) {
   for (const std::string& o : overrides) apply_override(doc, o);
   validate(doc, scene_schema());
-  return convert_and_check(doc);
+  return convert_and_check(std::move(doc), folder);
 }
 
 std::string resolve_scene_path(const std::string& name) {
@@ -450,7 +529,7 @@ Scene load_scene(const std::string& file, const std::vector<std::string>& overri
   const std::string path = resolve_scene_path(file);
   Json doc = read_json_file(path);
   if (doc.is_object() && !doc.contains("name")) doc["name"] = std::filesystem::path(path).stem().string();
-  return scene_from_json(std::move(doc), overrides);
+  return scene_from_json(std::move(doc), overrides, std::filesystem::path(path).parent_path().string());
 }
 
 }  // namespace thaw

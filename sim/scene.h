@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/geometry/shape.h"
 #include "sim/schema.h"
 
 namespace thaw {
@@ -46,18 +47,22 @@ struct FluidBlock {
 };
 
 struct IceBlock {
+  // Fixed ice is held where it starts (its particles are anchored); free ice moves as a rigid body.
+  enum class Motion { Fixed, Free };
   int material = 0;  // an ice material
-  Box box;
+  Shape shape;       // filled with particles on a lattice of the scene's spacing (sim/geometry/voxelize.h)
+  Box box;           // the shape's bounding box
+  Motion motion = Motion::Fixed;
   double temperature = 0.0;  // initial [°C], at most the melting point
 };
 
 struct Solid {
-  enum class Shape { Box, Plane };
-  Shape shape = Shape::Box;
-  int material = 0;  // a held solid's material is its held variant
-  Box box;                                            // Shape::Box: the solid block
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();    // Shape::Plane: a point on the surface
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // Shape::Plane: points into the fluid
+  int material = 0;    // a held solid's material is its held variant
+  bool plane = false;  // the half-space behind a plane, rather than a shape
+  Shape shape;         // !plane: the solid, sampled as boundary particles near its surface
+  Box box;             // !plane: the shape's bounding box
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();    // plane: a point on the surface
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // plane: unit, points into the fluid
   double temperature = 20.0;                          // initial, or held [°C]
 };
 
@@ -143,8 +148,11 @@ int wall_layer_count(const Scene& s);
 // Throws SceneError (with a JSON path) or Error (missing/unreadable file).
 Scene load_scene(const std::string& file, const std::vector<std::string>& overrides = {});
 
-// Same from an in-memory document (used by validation cases and tests).
-Scene scene_from_json(Json doc, const std::vector<std::string>& overrides = {});
+// Same from an in-memory document (used by validation cases and tests). A relative `mesh` path is looked
+// for in `folder` (the scene file's; empty: the working directory), then in configs/ of the source tree;
+// the Scene's `source` holds the path it was found at.
+Scene scene_from_json(Json doc, const std::vector<std::string>& overrides = {},
+                      const std::string& folder = "");
 
 // Applies one "path=value" override; value is JSON, or a bare string when it is not valid JSON.
 // Paths: "solver.cfl", "fluids[0].box.max", "fluids.0.box.max", "gravity[2]".
@@ -165,6 +173,16 @@ std::string resolve_scene_path(const std::string& name);
 // validation case can embed it in its own parameter object.
 const Field& scene_schema();
 const Field& solver_schema();
+
+// A field of ice and solid entries that several shapes take, such as `radius`. The schema ties a field to
+// one value of `shape` only, so these are declared optional there and checked against this list when the
+// scene converts (with the schema's messages: "only allowed when shape is ...", "missing: required ...").
+struct SharedShapeField {
+  std::string key;
+  std::vector<std::string> shapes;  // the shapes that take it
+  bool required = true;             // by those shapes
+};
+const std::vector<SharedShapeField>& shared_shape_fields();
 
 // The typed settings of a "solver" object that has passed validate() against solver_schema().
 SolverSettings solver_settings_from_json(const Json& solver);

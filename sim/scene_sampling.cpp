@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sim/error.h"
+#include "sim/geometry/voxelize.h"
 #include "sim/solver.h"
 #include "sim/thermal.h"
 
@@ -26,7 +27,31 @@ void lattice(const Vec3& min, const Vec3& max, double dx, F&& visit) {
       for (int i = 0; i < n.x(); ++i) visit(Vec3(min + dx * Vec3(i + 0.5, j + 0.5, k + 0.5)));
 }
 
-void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase, int material, double enthalpy) {
+// Keeps the points for which `covered` is 0, in their order.
+void drop(std::vector<Vec3>& points, const std::vector<std::uint8_t>& covered) {
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!covered[i]) points[kept++] = points[i];
+  points.resize(kept);
+}
+
+void drop_inside(std::vector<Vec3>& points, const Shape& shape) { drop(points, shape.contains(points)); }
+
+void drop_inside(std::vector<Vec3>& points, const Solid& s) {
+  if (!s.plane) return drop_inside(points, s.shape);
+  std::vector<std::uint8_t> behind(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) behind[i] = (points[i] - s.point).dot(s.normal) < 0;
+  drop(points, behind);
+}
+
+void drop_outside(std::vector<Vec3>& points, const Box& b) {
+  std::vector<std::uint8_t> outside(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) outside[i] = !inside(b, points[i]);
+  drop(points, outside);
+}
+
+void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase, int material,
+         double enthalpy, bool anchored = false) {
   p.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
   const float hi = static_cast<float>(enthalpy);
   p.enthalpy.push_back({hi, static_cast<float>(enthalpy - double(hi))});
@@ -35,6 +60,7 @@ void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase
   p.phase.push_back(static_cast<std::uint8_t>(phase));
   p.material.push_back(static_cast<std::uint8_t>(material));
   p.id.push_back(static_cast<std::uint32_t>(p.id.size()));
+  p.anchored.push_back(anchored ? 1 : 0);
 }
 
 }  // namespace
@@ -46,20 +72,11 @@ HostParticles sample_scene(const Scene& scene) {
   const double depth = layers * dx;
 
   // Boundary particles first; their mass (Psi) is left 0 for the solver to compute.
-  auto in_solid = [&](const Vec3& x) {
-    for (const auto& s : scene.solids) {
-      if (s.shape == Solid::Shape::Box && inside(s.box, x)) return true;
-      if (s.shape == Solid::Shape::Plane && (x - s.point).dot(s.normal.normalized()) < 0) return true;
-    }
-    return false;
-  };
   for (const auto& s : scene.solids) {
     const double h_solid = enthalpy_at(scene, s.material, s.temperature);
-    if (s.shape == Solid::Shape::Box) {
-      lattice(s.box.min, s.box.max, dx, [&](const Vec3& x) {
-        const double to_face = std::min((x - s.box.min).minCoeff(), (s.box.max - x).minCoeff());
-        if (to_face < depth) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
-      });
+    if (!s.plane) {
+      for (const Vec3& x : voxelize_shell(s.shape, dx, layers, &scene.domain.min))
+        add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
     } else {
       // Layers behind the plane, clipped to the domain grown by the layer depth.
       const Vec3 nrm = s.normal.normalized();
@@ -100,32 +117,31 @@ HostParticles sample_scene(const Scene& scene) {
         add(p, x, Vec3::Zero(), 0.f, Phase::Solid, scene.wall_material, h_wall);
     });
   }
-  // Ice blocks: static, with the SPH mass of a boundary particle (rho0 dx^3; sim/thermal.h).
-  auto in_ice = [&](const Vec3& x, std::size_t before) {
-    for (std::size_t e = 0; e < before; ++e)
-      if (inside(scene.ice[e].box, x)) return true;
-    return false;
-  };
+  // Ice: the lattice points of its shape, with the SPH mass of a boundary particle (rho0 dx^3;
+  // sim/thermal.h), skipping points inside solids or earlier ice.
   const float boundary_mass = static_cast<float>(derive_constants(scene).rest_density * dx * dx * dx);
   for (std::size_t b = 0; b < scene.ice.size(); ++b) {
     const auto& c = scene.ice[b];
     const double h = enthalpy_at(scene, c.material, c.temperature);
-    lattice(c.box.min, c.box.max, dx, [&](const Vec3& x) {
-      if (!inside(scene.domain, x) || in_solid(x) || in_ice(x, b)) return;
-      add(p, x, Vec3::Zero(), boundary_mass, Phase::Ice, c.material, h);
-    });
+    std::vector<Vec3> points = voxelize(c.shape, dx, &scene.domain.min);
+    drop_outside(points, scene.domain);
+    for (const auto& s : scene.solids) drop_inside(points, s);
+    for (std::size_t e = 0; e < b; ++e) drop_inside(points, scene.ice[e].shape);
+    const bool anchored = c.motion == IceBlock::Motion::Fixed;
+    for (const Vec3& x : points) add(p, x, Vec3::Zero(), boundary_mass, Phase::Ice, c.material, h, anchored);
   }
-  // Fluid blocks, skipping lattice points inside solids or an earlier block.
+  // Fluid blocks, skipping lattice points inside solids, ice or an earlier block.
   for (std::size_t b = 0; b < scene.fluids.size(); ++b) {
     const auto& f = scene.fluids[b];
     const float mass = static_cast<float>(scene.materials[f.material].density * dx * dx * dx);
     const double h = enthalpy_at(scene, f.material, f.temperature);
-    lattice(f.box.min, f.box.max, dx, [&](const Vec3& x) {
-      if (!inside(scene.domain, x) || in_solid(x) || in_ice(x, scene.ice.size())) return;
-      for (std::size_t e = 0; e < b; ++e)
-        if (inside(scene.fluids[e].box, x)) return;
-      add(p, x, f.velocity, mass, Phase::Water, f.material, h);
-    });
+    std::vector<Vec3> points = voxelize(Shape::box(f.box.min, f.box.max), dx);
+    drop_outside(points, scene.domain);
+    for (const auto& s : scene.solids) drop_inside(points, s);
+    for (const auto& c : scene.ice) drop_inside(points, c.shape);
+    for (std::size_t e = 0; e < b; ++e)
+      drop_inside(points, Shape::box(scene.fluids[e].box.min, scene.fluids[e].box.max));
+    for (const Vec3& x : points) add(p, x, f.velocity, mass, Phase::Water, f.material, h);
   }
   if (p.size() > std::size_t(0xffffffffu)) throw SceneError("spacing", "too many particles for 32-bit ids");
   return p;

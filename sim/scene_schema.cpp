@@ -1,5 +1,8 @@
 // The scene format, declared once: validation, `--set`, docs/SCENES.md and the protocol's list of
 // live parameters all read these declarations.
+#include <algorithm>
+#include <utility>
+
 #include "sim/scene.h"
 
 namespace thaw {
@@ -100,7 +103,76 @@ Field box_field(std::string key, std::string doc) {
                 std::move(doc));
 }
 
+// " (shape sphere, mesh; required there)": which shapes take a field that several share.
+std::string shared_note(const std::string& key) {
+  for (const SharedShapeField& f : shared_shape_fields()) {
+    if (f.key != key) continue;
+    std::string shapes;
+    for (const std::string& shape : f.shapes) shapes += (shapes.empty() ? "" : ", ") + shape;
+    return " (shape " + shapes + (f.required ? "; required there)" : ")");
+  }
+  return "";
+}
+
+// The fields after `shape` that say where a shape is and how big; `box` keeps its meaning from before
+// shapes (fill the block).
+std::vector<Field> shape_fields(const std::string& box_doc) {
+  return {
+      box_field("box", box_doc).when("shape", "box"),
+      vec3("centre", "Centre of the sphere; for a mesh, where the centre of its bounding box goes" +
+                         shared_note("centre"))
+          .in("m")
+          .optional(),
+      number("radius",
+             "Radius of the sphere, cylinder or capsule, or of the cone's base" + shared_note("radius"))
+          .in("m")
+          .above(0)
+          .optional(),
+      vec3("from",
+           "Centre of one end of the cylinder or capsule, or of the cone's base" + shared_note("from"))
+          .in("m")
+          .optional(),
+      vec3("to", "Centre of the other end, or the cone's apex; not equal to from" + shared_note("to"))
+          .in("m")
+          .optional(),
+      text("mesh",
+           "OBJ, STL or PLY file: relative to the scene file's folder, else to configs/; the inside is "
+           "where the generalized winding number exceeds 1/2, so small holes do no harm")
+          .when("shape", "mesh"),
+      number("size", "Largest extent of the mesh's bounding box after rotation")
+          .in("m")
+          .above(0)
+          .when("shape", "mesh"),
+      vec3("rotation",
+           "Degrees about x, then y, then z; a box turns about its centre, a mesh before it is "
+           "placed; default [0, 0, 0]" +
+               shared_note("rotation"))
+          .in("deg")
+          .optional(),
+  };
+}
+
+// An ice or solid entry: its shape, its material, the shape's fields, then `rest`.
+std::vector<Field> shaped_entry(Field shape, Field material, const std::string& box_doc,
+                                std::vector<Field> rest) {
+  std::vector<Field> fields = {std::move(shape), std::move(material)};
+  for (Field& f : shape_fields(box_doc)) fields.push_back(std::move(f));
+  for (Field& f : rest) fields.push_back(std::move(f));
+  return fields;
+}
+
 }  // namespace
+
+const std::vector<SharedShapeField>& shared_shape_fields() {
+  static const std::vector<SharedShapeField> fields = {
+      {"centre", {"sphere", "mesh"}, true},
+      {"radius", {"sphere", "cylinder", "cone", "capsule"}, true},
+      {"from", {"cylinder", "cone", "capsule"}, true},
+      {"to", {"cylinder", "cone", "capsule"}, true},
+      {"rotation", {"box", "mesh"}, false},
+  };
+  return fields;
+}
 
 const Field& scene_schema() {
   static const Field scene = object(
@@ -108,98 +180,108 @@ const Field& scene_schema() {
       {
           text("name", "Short name shown by the CLI and the browser; defaults to the file name").def(""),
           text("description", "What the scene shows, and any liberties it takes with physics").def(""),
-          object("domain",
-                 {
-                     vec3("min", "Lower corner").in("m"),
-                     vec3("max", "Upper corner; above min on every axis").in("m"),
-                     subset("walls", {"-x", "+x", "-y", "+y", "-z", "+z"},
-                            "Sides of the domain lined with solid")
-                         .def(Json::array()),
-                     text("wall_material", "Material of the walls, a solid; required when walls is not empty")
-                         .optional(),
-                     integer("wall_layers", "Layers of wall particles; 0 = enough to fill the kernel support")
-                         .def(0)
-                         .at_least(0)
-                         .at_most(10),
-                     object("wall_heat",
-                            {
-                                number("coefficient",
-                                       "U of the heat flux U (T_outside - T_wall) through the walls' outer face; "
-                                       "0 = insulated")
-                                    .in("W/m^2/K")
-                                    .def(0.0)
-                                    .at_least(0)
-                                    .at_most(1e5)
-                                    .client_settable(),
-                                number("temperature", "Temperature outside the tank")
-                                    .in("°C")
-                                    .def(20.0)
-                                    .above(-273.15)
-                                    .at_most(1000)
-                                    .client_settable(),
-                            },
-                            "Heat exchange of the tank walls with the outside (Domaradzki & Martyn sec. 7)."),
-                 },
-                 "The simulated box; particles that leave it are clamped back and counted."),
+          object(
+              "domain",
+              {
+                  vec3("min", "Lower corner").in("m"),
+                  vec3("max", "Upper corner; above min on every axis").in("m"),
+                  subset("walls", {"-x", "+x", "-y", "+y", "-z", "+z"},
+                         "Sides of the domain lined with solid")
+                      .def(Json::array()),
+                  text("wall_material", "Material of the walls, a solid; required when walls is not empty")
+                      .optional(),
+                  integer("wall_layers", "Layers of wall particles; 0 = enough to fill the kernel support")
+                      .def(0)
+                      .at_least(0)
+                      .at_most(10),
+                  object(
+                      "wall_heat",
+                      {
+                          number("coefficient",
+                                 "U of the heat flux U (T_outside - T_wall) through the walls' outer face; "
+                                 "0 = insulated")
+                              .in("W/m^2/K")
+                              .def(0.0)
+                              .at_least(0)
+                              .at_most(1e5)
+                              .client_settable(),
+                          number("temperature", "Temperature outside the tank")
+                              .in("°C")
+                              .def(20.0)
+                              .above(-273.15)
+                              .at_most(1000)
+                              .client_settable(),
+                      },
+                      "Heat exchange of the tank walls with the outside (Domaradzki & Martyn sec. 7)."),
+              },
+              "The simulated box; particles that leave it are clamped back and counted."),
           vec3("gravity", "Gravitational acceleration").in("m/s^2").def({0.0, 0.0, -9.81}).client_settable(),
           number("spacing", "Particle spacing; sets the resolution").in("m").above(0),
           solver_schema(),
-          object("heat",
-                 {
-                     flag("enabled", "Run the thermal stages: conduction, heat sources, phase change").def(true),
-                     number("time_scale",
-                            "Heat flows this many times faster than the water moves: 1 is physical; interactive "
-                            "scenes may raise it and say so in their description")
-                         .def(1.0)
-                         .above(0)
-                         .at_most(1e6)
-                         .client_settable(),
-                     choice("exposed_area", {"iwasaki2010"},
-                            "Model of each particle's surface exposed to air: iwasaki2010 = (6 - n_i) / 6 of a "
-                            "voxel's six faces, n_i the particles within 1.2 spacings (Iwasaki et al. 2010 sec. "
-                            "4)")
-                         .def("iwasaki2010"),
-                 },
-                 "Heat transfer and phase change (Iwasaki et al. 2010; DESIGN.md Numerics)."),
-          object("ambient",
-                 {
-                     number("temperature", "Air around the scene; objects without a temperature start at it")
-                         .in("°C")
-                         .def(20.0)
-                         .above(-273.15)
-                         .at_most(1000)
-                         .client_settable(),
-                     number("heat_transfer_coefficient",
-                            "h in Newton's cooling h (T_air - T) dA through the exposed surface of ice and water; "
-                            "0 = insulated")
-                         .in("W/m^2/K")
-                         .def(10.0)
-                         .at_least(0)
-                         .at_most(1e4)
-                         .client_settable(),
-                 },
-                 "Still air around the scene (the mode without air particles)."),
-          map_of("materials", "<name>",
-                 {
-                     choice("kind", {"fluid", "solid", "ice"},
-                            "Fluid particles move; solids are static boundaries; ice stays in place and melts "
-                            "into its melts_into fluid"),
-                     number("density", "Rest density").in("kg/m^3").above(0).at_most(1e5),
-                     number("viscosity", "Dynamic viscosity (fluids)").in("Pa s").def(0.0).at_least(0),
-                     number("conductivity", "Thermal conductivity k").in("W/m/K").at_least(0).at_most(1e4),
-                     number("specific_heat", "Specific heat capacity c").in("J/kg/K").above(0).at_most(1e6),
-                     text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
-                         .when("kind", "ice"),
-                     number("latent_heat", "Latent heat of fusion L").in("J/kg").def(334000.0).above(0).at_most(1e8).when(
-                         "kind", "ice"),
-                     number("melting_point", "Melting temperature T_m")
-                         .in("°C")
-                         .def(0.0)
-                         .above(-273.15)
-                         .at_most(3000)
-                         .when("kind", "ice"),
-                 },
-                 "Materials by name; objects refer to them by name.")
+          object(
+              "heat",
+              {
+                  flag("enabled", "Run the thermal stages: conduction, heat sources, phase change").def(true),
+                  number("time_scale",
+                         "Heat flows this many times faster than the water moves: 1 is physical; interactive "
+                         "scenes may raise it and say so in their description")
+                      .def(1.0)
+                      .above(0)
+                      .at_most(1e6)
+                      .client_settable(),
+                  choice("exposed_area", {"iwasaki2010"},
+                         "Model of each particle's surface exposed to air: iwasaki2010 = (6 - n_i) / 6 of a "
+                         "voxel's six faces, n_i the particles within 1.2 spacings (Iwasaki et al. 2010 sec. "
+                         "4)")
+                      .def("iwasaki2010"),
+              },
+              "Heat transfer and phase change (Iwasaki et al. 2010; DESIGN.md Numerics)."),
+          object(
+              "ambient",
+              {
+                  number("temperature", "Air around the scene; objects without a temperature start at it")
+                      .in("°C")
+                      .def(20.0)
+                      .above(-273.15)
+                      .at_most(1000)
+                      .client_settable(),
+                  number(
+                      "heat_transfer_coefficient",
+                      "h in Newton's cooling h (T_air - T) dA through the exposed surface of ice and water; "
+                      "0 = insulated")
+                      .in("W/m^2/K")
+                      .def(10.0)
+                      .at_least(0)
+                      .at_most(1e4)
+                      .client_settable(),
+              },
+              "Still air around the scene (the mode without air particles)."),
+          map_of(
+              "materials", "<name>",
+              {
+                  choice("kind", {"fluid", "solid", "ice"},
+                         "Fluid particles move; solids are static boundaries; ice stays in place and melts "
+                         "into its melts_into fluid"),
+                  number("density", "Rest density").in("kg/m^3").above(0).at_most(1e5),
+                  number("viscosity", "Dynamic viscosity (fluids)").in("Pa s").def(0.0).at_least(0),
+                  number("conductivity", "Thermal conductivity k").in("W/m/K").at_least(0).at_most(1e4),
+                  number("specific_heat", "Specific heat capacity c").in("J/kg/K").above(0).at_most(1e6),
+                  text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
+                      .when("kind", "ice"),
+                  number("latent_heat", "Latent heat of fusion L")
+                      .in("J/kg")
+                      .def(334000.0)
+                      .above(0)
+                      .at_most(1e8)
+                      .when("kind", "ice"),
+                  number("melting_point", "Melting temperature T_m")
+                      .in("°C")
+                      .def(0.0)
+                      .above(-273.15)
+                      .at_most(3000)
+                      .when("kind", "ice"),
+              },
+              "Materials by name; objects refer to them by name.")
               .non_empty(),
           array_of("fluids",
                    {
@@ -214,93 +296,123 @@ const Field& scene_schema() {
                    },
                    "Blocks of fluid particles.")
               .def(Json::array()),
-          array_of("ice",
-                   {
-                       text("material", "Name of an ice material"),
-                       box_field("box", "Filled with particles on a lattice of the scene's spacing"),
-                       number("temperature", "Initial temperature, at most the melting point; default "
-                                             "ambient.temperature or the melting point, whichever is lower")
-                           .in("°C")
-                           .above(-273.15)
-                           .at_most(3000)
-                           .optional(),
-                   },
-                   "Blocks of ice, held in place (rigid motion comes later); they melt into water.")
+          array_of(
+              "ice",
+              shaped_entry(
+                  choice("shape", {"box", "sphere", "cylinder", "cone", "capsule", "mesh"},
+                         "What the ice fills: an axis-aligned box (turned by rotation), a sphere, a "
+                         "cylinder, a cone, a capsule or a mesh file")
+                      .def("box"),
+                  text("material", "Name of an ice material"),
+                  "The block, filled with particles on a lattice of the scene's spacing",
+                  {
+                      choice("motion", {"fixed", "free"},
+                             "fixed: held where it starts (its particles are anchored); free: moves as one "
+                             "rigid body")
+                          .def("fixed"),
+                      number("temperature",
+                             "Initial temperature, at most the melting point; default "
+                             "ambient.temperature or the melting point, whichever is lower")
+                          .in("°C")
+                          .above(-273.15)
+                          .at_most(3000)
+                          .optional(),
+                  }),
+              "Pieces of ice of any shape, sampled on the particle lattice (lattice points inside solids or "
+              "earlier ice are left out); they melt into water.")
               .def(Json::array()),
-          array_of("solids",
-                   {
-                       choice("shape", {"box", "plane"}, "Solid block or half-space"),
-                       text("material", "Name of a solid material"),
-                       box_field("box", "The solid block").when("shape", "box"),
-                       vec3("point", "A point on the plane").in("m").when("shape", "plane"),
-                       vec3("normal", "Plane normal, pointing into the fluid; need not be unit length")
-                           .when("shape", "plane"),
-                       number("temperature", "Initial temperature; default ambient.temperature")
-                           .in("°C")
-                           .above(-273.15)
-                           .at_most(3000)
-                           .optional(),
-                       flag("hold_temperature",
-                            "Hold the solid at its temperature, like a heater or a cooling plate; the heat that "
-                            "takes is reported as `held` in the energy budget")
-                           .def(false),
-                   },
-                   "Static solids, sampled as boundary particles; they conduct heat.")
+          array_of(
+              "solids",
+              shaped_entry(
+                  choice("shape", {"box", "sphere", "cylinder", "cone", "capsule", "mesh", "plane"},
+                         "Solid of one of the ice shapes, or the half-space behind a plane"),
+                  text("material", "Name of a solid material"), "The solid block",
+                  {
+                      vec3("point", "A point on the plane").in("m").when("shape", "plane"),
+                      vec3("normal", "Plane normal, pointing into the fluid; need not be unit length")
+                          .when("shape", "plane"),
+                      number("temperature", "Initial temperature; default ambient.temperature")
+                          .in("°C")
+                          .above(-273.15)
+                          .at_most(3000)
+                          .optional(),
+                      flag("hold_temperature",
+                           "Hold the solid at its temperature, like a heater or a cooling plate; the heat "
+                           "that takes is reported as `held` in the energy budget")
+                          .def(false),
+                  }),
+              "Static solids, sampled as boundary particles as deep as the kernel reaches; they conduct "
+              "heat.")
               .def(Json::array()),
-          array_of("lamps",
-                   {
-                       flag("on", "Emitting").def(true).client_settable(),
-                       vec3("centre", "Centre of the emitting rectangle").in("m").client_settable(),
-                       vec3("normal", "The way the emitting face looks; need not be unit length").client_settable(),
-                       number("width", "Extent of the rectangle across the normal (horizontal where it can be)")
-                           .in("m")
-                           .above(0)
-                           .at_most(100),
-                       number("height", "Extent of the rectangle along the third axis").in("m").above(0).at_most(100),
-                       number("temperature", "Emitter temperature T_s")
-                           .in("°C")
-                           .above(-273.15)
-                           .at_most(3000)
-                           .client_settable(),
-                       number("emissivity", "Emissivity factor").def(0.9).above(0).at_most(1).client_settable(),
-                       integer("photons", "Thermal photons emitted per step").def(4096).at_least(1).at_most(1 << 22),
-                   },
-                   "Radiant heaters, as thermal photons traced through the ice and solids (Iwasaki et al. 2010 "
-                   "sec. 4 and 6): the first ice or solid voxel a photon meets absorbs it.")
+          array_of(
+              "lamps",
+              {
+                  flag("on", "Emitting").def(true).client_settable(),
+                  vec3("centre", "Centre of the emitting rectangle").in("m").client_settable(),
+                  vec3("normal", "The way the emitting face looks; need not be unit length")
+                      .client_settable(),
+                  number("width", "Extent of the rectangle across the normal (horizontal where it can be)")
+                      .in("m")
+                      .above(0)
+                      .at_most(100),
+                  number("height", "Extent of the rectangle along the third axis")
+                      .in("m")
+                      .above(0)
+                      .at_most(100),
+                  number("temperature", "Emitter temperature T_s")
+                      .in("°C")
+                      .above(-273.15)
+                      .at_most(3000)
+                      .client_settable(),
+                  number("emissivity", "Emissivity factor").def(0.9).above(0).at_most(1).client_settable(),
+                  integer("photons", "Thermal photons emitted per step")
+                      .def(4096)
+                      .at_least(1)
+                      .at_most(1 << 22),
+              },
+              "Radiant heaters, as thermal photons traced through the ice and solids (Iwasaki et al. 2010 "
+              "sec. 4 and 6): the first ice or solid voxel a photon meets absorbs it.")
               .def(Json::array()),
-          array_of("dryers",
-                   {
-                       flag("on", "Blowing").def(true).client_settable(),
-                       vec3("position", "Nozzle position").in("m").client_settable(),
-                       vec3("direction", "Where the air blows; need not be unit length").client_settable(),
-                       number("half_angle", "Half-angle of the cone of warm air")
-                           .in("deg")
-                           .def(15.0)
-                           .above(0)
-                           .at_most(60)
-                           .client_settable(),
-                       number("reach", "Length of the cone; nothing beyond it feels the dryer")
-                           .in("m")
-                           .def(0.3)
-                           .above(0)
-                           .at_most(10)
-                           .client_settable(),
-                       number("temperature", "Air temperature at the nozzle")
-                           .in("°C")
-                           .def(60.0)
-                           .above(-100)
-                           .at_most(500)
-                           .client_settable(),
-                       number("speed", "Air speed at the nozzle").in("m/s").def(10.0).at_least(0).at_most(100).client_settable(),
-                       number("nozzle_diameter", "Sets the jet's core length (6 diameters) and the length scale of "
-                                                 "its heat-transfer coefficient")
-                           .in("m")
-                           .def(0.04)
-                           .above(0)
-                           .at_most(1),
-                   },
-                   "Hair dryers without air particles: a cone of warm, fast air that heats the exposed surface "
-                   "inside it (sim/heat_sources.h has the model).")
+          array_of(
+              "dryers",
+              {
+                  flag("on", "Blowing").def(true).client_settable(),
+                  vec3("position", "Nozzle position").in("m").client_settable(),
+                  vec3("direction", "Where the air blows; need not be unit length").client_settable(),
+                  number("half_angle", "Half-angle of the cone of warm air")
+                      .in("deg")
+                      .def(15.0)
+                      .above(0)
+                      .at_most(60)
+                      .client_settable(),
+                  number("reach", "Length of the cone; nothing beyond it feels the dryer")
+                      .in("m")
+                      .def(0.3)
+                      .above(0)
+                      .at_most(10)
+                      .client_settable(),
+                  number("temperature", "Air temperature at the nozzle")
+                      .in("°C")
+                      .def(60.0)
+                      .above(-100)
+                      .at_most(500)
+                      .client_settable(),
+                  number("speed", "Air speed at the nozzle")
+                      .in("m/s")
+                      .def(10.0)
+                      .at_least(0)
+                      .at_most(100)
+                      .client_settable(),
+                  number("nozzle_diameter",
+                         "Sets the jet's core length (6 diameters) and the length scale of "
+                         "its heat-transfer coefficient")
+                      .in("m")
+                      .def(0.04)
+                      .above(0)
+                      .at_most(1),
+              },
+              "Hair dryers without air particles: a cone of warm, fast air that heats the exposed surface "
+              "inside it (sim/heat_sources.h has the model).")
               .def(Json::array()),
       });
   return scene;
@@ -331,8 +443,10 @@ Checked across fields:
 - a fluid block's material is a fluid, a solid's and the walls' material is a solid, and every
   material name is defined in `materials`;
 - `domain.wall_material` is given when `domain.walls` is not empty;
-- fluid and ice blocks lie inside the domain; plane normals, lamp normals and dryer directions are not
-  zero; the scene has at least one fluid or ice block;
+- fluid blocks and the bounding boxes of ice lie inside the domain; plane normals, lamp normals and dryer
+  directions are not zero; the scene has at least one fluid or ice block;
+- an ice or solid entry has exactly the fields its `shape` takes (below); a cylinder's, cone's or
+  capsule's `to` differs from its `from`; a mesh file is found, reads, and has triangles;
 - an ice material's `melts_into` names a fluid, and no two ice materials melt into the same fluid; ice
   starts at or below its melting point, and a fluid that freezes starts at or above it;
 - `solver.min_dt` is below `solver.max_dt`;
@@ -342,6 +456,34 @@ Checked across fields:
 Temperatures are in °C. Each particle carries its specific enthalpy; an ice particle turns to water when
 it has taken its whole latent heat, and water freezes when it has given it all back
 (`sim/kernels/thermal_law.h`).
+
+## Shapes
+
+Ice and solids take a `shape`, with these fields:
+
+)";
+
+// What each shape is, for the table in docs/SCENES.md; its fields come from the declarations.
+constexpr std::pair<const char*, const char*> kShapeMeaning[] = {
+    {"box", "the box, turned about its centre; ice's default shape"},
+    {"sphere", "the ball of `radius` about `centre`"},
+    {"cylinder", "flat ends at `from` and `to`"},
+    {"cone", "base circle at `from`, apex at `to`: an icicle runs from root to tip"},
+    {"capsule", "the points within `radius` of the segment"},
+    {"mesh",
+     "an OBJ, STL or PLY file, turned by `rotation`, scaled so that the largest side of its bounding box "
+     "is `size`, moved so that the box's centre is at `centre`"},
+    {"plane", "the half-space behind the plane (solids only)"},
+};
+
+constexpr const char* kShapes = R"(
+`rotation` is in degrees about x, then y, then z, and defaults to none. A shape is filled with the lattice
+points `min + (i + 1/2) spacing` of its bounding box that lie inside it; an axis-aligned box keeps its
+whole cells, as blocks always have. Inside a mesh is where its generalized winding number exceeds 1/2
+(Jacobson et al. 2013), so a mesh with small holes still fills. Ice leaves out lattice points inside
+solids and earlier ice; fluids leave out points inside solids and ice; solids are sampled only as deep as
+the kernel reaches. Ice is `fixed` (held where it starts; its particles are anchored) or `free` (a rigid
+body of its own). Shipped meshes live in `configs/meshes/`.
 
 ## Example
 
@@ -370,12 +512,31 @@ constexpr const char* kExample = R"({
 }
 )";
 
+// One row per shape: the fields the solids' declarations tie to it (solids take every shape).
+std::string shapes_table() {
+  const Field& entry = *find_field(scene_schema(), "solids[0]");
+  std::string table = "| shape | fields | the volume |\n|---|---|---|\n";
+  for (const auto& [shape, meaning] : kShapeMeaning) {
+    std::string fields;
+    for (const Field& f : entry.fields) {
+      bool takes = f.when_key == "shape" && f.when_value == shape;
+      for (const SharedShapeField& shared : shared_shape_fields())
+        takes = takes || (shared.key == f.key && std::find(shared.shapes.begin(), shared.shapes.end(),
+                                                           shape) != shared.shapes.end());
+      if (takes) fields += (fields.empty() ? "`" : ", `") + f.key + "`";
+    }
+    table += "| `" + std::string(shape) + "` | " + fields + " | " + meaning + " |\n";
+  }
+  return table;
+}
+
 }  // namespace
 
 std::string scene_example_json() { return kExample; }
 
 std::string scene_reference_markdown() {
-  return std::string(kIntro) + kExample + "```\n\n" + schema_markdown(scene_schema(), "Reference: top level");
+  return std::string(kIntro) + shapes_table() + kShapes + kExample + "```\n\n" +
+         schema_markdown(scene_schema(), "Reference: top level");
 }
 
 }  // namespace thaw

@@ -10,6 +10,7 @@
 #include "sim/error.h"
 #include "sim/kernels/dryer_model.h"
 #include "sim/photons.h"
+#include "sim/rigid_ice.h"
 #include "sim/thermal.h"
 
 namespace thaw {
@@ -61,6 +62,38 @@ ClGrid cl_grid(const Solver::GridInfo& gi) {
           gi.nz};
 }
 
+// Per material, the factor from a particle's SPH mass to its physical mass: fluids carry their
+// physical mass, static particles and ice the rest-density mass rho0 V (as in sim/thermal.cpp).
+std::vector<float> mass_scales(const Scene& scene, double rest_density) {
+  std::vector<float> out;
+  for (const Material& m : scene.materials)
+    out.push_back(static_cast<float>(m.kind == "fluid" ? 1.0 : m.density / rest_density));
+  return out;
+}
+
+RigidIce::Settings rigid_settings(const Scene& scene, const SolverConstants& k) {
+  RigidIce::Settings r;
+  r.spacing = scene.spacing;
+  r.support = k.support;
+  r.smoothing = k.smoothing;
+  r.visc_boundary = k.visc_boundary;
+  r.gravity = scene.gravity;
+  r.grid_reach = kGridReach;
+  // Contact springs as stiff as the water: k = rho0 c^2 dx oscillates a particle at about c / dx, which
+  // the acoustic time step already resolves, and a resting body sinks into a floor by only
+  // n dx g / c^2 (n particles high): a fraction of a percent of a spacing. Damping half the critical
+  // value of an ice particle's mass; friction of wet ice on ice or glass.
+  const double dx = scene.spacing;
+  double rho_ice = k.rest_density;
+  for (const Material& m : scene.materials)
+    if (m.kind == "ice") rho_ice = m.density;
+  r.contact.stiffness = double(k.rest_density) * k.sound_speed * k.sound_speed * dx;
+  r.contact.damping = 2.0 * 0.5 * std::sqrt(r.contact.stiffness * rho_ice * dx * dx * dx);
+  r.contact.friction = 0.1;
+  r.contact.distance = dx;
+  return r;
+}
+
 }  // namespace
 
 SolverConstants derive_constants(const Scene& scene) {
@@ -98,7 +131,8 @@ SolverConstants derive_constants(const Scene& scene) {
       for (const auto& f : scene.fluids) top = std::max(top, f.box.max_along(up));
       for (const auto& c : scene.ice) top = std::max(top, c.box.max_along(up));
       const double bottom = -scene.domain.max_along(-up);
-      if (!scene.fluids.empty() || !scene.ice.empty()) v_ref = std::sqrt(2.0 * g * std::max(0.0, top - bottom));
+      if (!scene.fluids.empty() || !scene.ice.empty())
+        v_ref = std::sqrt(2.0 * g * std::max(0.0, top - bottom));
     }
     for (const auto& f : scene.fluids) v_ref = std::max(v_ref, f.velocity.norm());
     v_ref = std::max(v_ref, 0.1);  // a still fluid in zero gravity still needs a finite stiffness
@@ -121,7 +155,8 @@ SolverConstants derive_constants(const Scene& scene) {
   k.wall_dt = inf;
   const double dx = scene.spacing;
   for (const Material& m : scene.materials) {
-    if (m.kind != "solid") k.exposed_capacity = std::min(k.exposed_capacity, m.density * m.specific_heat * dx / 6.0);
+    if (m.kind != "solid")
+      k.exposed_capacity = std::min(k.exposed_capacity, m.density * m.specific_heat * dx / 6.0);
     if (m.wall_heat) {
       k.wall_dt = std::min(k.wall_dt, 0.5 * m.density * m.specific_heat * dx * wall_layer_count(scene) /
                                           (scene.heat.time_scale * scene.heat.wall_coefficient));
@@ -135,8 +170,7 @@ std::vector<double> EnergyBudget::to_vector() const {
 }
 
 EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
-  if (v.size() != 8)
-    throw Error("energy budget has " + std::to_string(v.size()) + " entries, expected 8");
+  if (v.size() != 8) throw Error("energy budget has " + std::to_string(v.size()) + " entries, expected 8");
   EnergyBudget b;
   b.initial = v[0];
   b.ambient = v[1];
@@ -225,7 +259,8 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   if (heat_) {
     std::string heat_opts = opts.str() + " -DTHAW_EXPOSED_AREA=" + scene.heat.exposed_area;
     for (int a = 0; a < 3; ++a)
-      if (scene.solver.periodic[static_cast<std::size_t>(a)]) heat_opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
+      if (scene.solver.periodic[static_cast<std::size_t>(a)])
+        heat_opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
     const auto heat = cl.build(with_prelude({"thermal_law.h", "dryer_model.h", "heat.cl"}), heat_opts);
     k_thermal_state_ = cl::Kernel(heat, "thermal_state");
     k_heat_ = cl::Kernel(heat, "heat");
@@ -279,8 +314,8 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   spare_enthalpy_ = buf(n * 8);
   if (heat_) {
     table_ = material_thermal_table(scene, k_.rest_density);
-    materials_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table_.size() * sizeof(MaterialThermal),
-                            table_.data());
+    materials_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                            table_.size() * sizeof(MaterialThermal), table_.data());
     thermal_ = buf(std::size_t(stride_) * 3 * 4);
     cl.queue().enqueueFillBuffer(thermal_, 0.0f, 0, std::size_t(stride_) * 3 * 4);
     lamp_energy_ = buf(n * 4);
@@ -290,6 +325,8 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     budget_parts_ = buf(std::size_t(stride_) * 5 * 4);
     budget_tiles_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 5 * 4);
     budget_bad_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 4);
+    phase_changed_ = buf(4);
+    cl.queue().enqueueFillBuffer(phase_changed_, cl_uint(0), 0, 4);
     dryers_ = buf(std::max<std::size_t>(scene.dryers.size(), 1) * sizeof(dryer::DryerJet));
     if (!scene.lamps.empty()) {
       // Voxels of one spacing over every particle: a lattice of that spacing puts one particle in each,
@@ -333,9 +370,25 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
       budget_.initial = total_enthalpy();
     }
   }
+  const bool free_ice = std::any_of(scene.ice.begin(), scene.ice.end(),
+                                    [](const IceBlock& b) { return b.motion == IceBlock::Motion::Free; });
+  if (free_ice && scene.solver.flow) {
+    std::vector<std::uint8_t> anchored_by_id(n_, 0);
+    for (std::size_t i = 0; i < n_ && i < p.anchored.size(); ++i)
+      if (p.id[i] < n_) anchored_by_id[p.id[i]] = p.anchored[i];
+    rigid_ = std::make_unique<RigidIce>(cl, opts.str(), n_, rigid_settings(scene, k_),
+                                        std::move(anchored_by_id), mass_scales(scene, k_.rest_density));
+    if (!st.rigid_body.empty()) rigid_->restore({st.rigid_body, st.rigid_offset, st.rigid_bodies}, n_);
+  }
 }
 
 Solver::~Solver() = default;
+
+ParticleBuffers Solver::buffers() const {
+  return {position_,   velocity_,      state_,
+          phase_,      material_,      id_,
+          cell_start_, cl_grid(grid_), static_cast<std::uint32_t>(n_)};
+}
 
 void Solver::upload(const HostParticles& p) {
   auto& q = cl_.queue();
@@ -400,6 +453,7 @@ void Solver::build_grid() {
   std::swap(phase_, spare_phase_);
   std::swap(material_, spare_mat_);
   std::swap(id_, spare_id_);
+  if (rigid_) rigid_->reorder(order, n);
 
   set_args(k_starts_, keys, cell_start_, n, ncells_);
   launch(q, k_starts_, n_ + 1);
@@ -505,7 +559,14 @@ double Solver::choose_time_step() {
         where() + particle_at(bad & 0x7fffffffu) +
         (accel_only ? " has a non-finite acceleration" : " has a non-finite position or velocity") + advice);
   }
-  const double vmax = std::sqrt(vmax2);
+  const double body_speed = rigid_ ? rigid_->max_point_speed() : 0.0;
+  if (body_speed > k_.max_speed) {
+    std::ostringstream os;
+    os << where() << "an ice body moves at " << body_speed << " m/s, above the limit " << k_.max_speed
+       << " m/s (solver.max_speed)" << advice;
+    throw BlowUpError(os.str());
+  }
+  const double vmax = std::max(std::sqrt(vmax2), body_speed);
   if (vmax > k_.max_speed) {
     std::ostringstream os;
     os << where() << particle_at(fastest) << " moves at " << vmax << " m/s, above the limit " << k_.max_speed
@@ -601,9 +662,10 @@ void Solver::compute_heat(double dt) {
   const float exposed_r2 = 1.44f * dx * dx;
   set_args(k_heat_, position_, velocity_, enthalpy_, phase_, material_, materials_, soa_, thermal_, stride_,
            cell_start_, g, k_.support, 0.01f * h * h, period, exposed_r2, dx * dx,
-           static_cast<float>(scene_.heat.ambient_temperature), static_cast<float>(scene_.heat.ambient_coefficient),
-           dryers_, static_cast<cl_uint>(scene_.dryers.size()), lamp_energy_,
-           static_cast<float>(scene_.heat.time_scale * dt), budget_parts_, n);
+           static_cast<float>(scene_.heat.ambient_temperature),
+           static_cast<float>(scene_.heat.ambient_coefficient), dryers_,
+           static_cast<cl_uint>(scene_.dryers.size()), lamp_energy_,
+           static_cast<float>(scene_.heat.time_scale * dt), budget_parts_, phase_changed_, n);
   launch(q, k_heat_, n_);
   set_args(k_heat_budget_, budget_parts_, enthalpy_, stride_, budget_tiles_, budget_bad_, n, tile_);
   q.enqueueNDRangeKernel(k_heat_budget_, cl::NullRange, global_for(ntiles_));
@@ -618,8 +680,9 @@ void Solver::compute_heat(double dt) {
       q.enqueueReadBuffer(position_, CL_TRUE, bad[t] * 16, 16, x.data());
       q.enqueueReadBuffer(id_, CL_TRUE, bad[t] * 4, 4, &id);
       std::ostringstream os;
-      os << "step " << steps_ + 1 << " (t = " << time_ << " s): particle " << id << " at (" << x[0] << ", " << x[1]
-         << ", " << x[2] << ") m has a non-finite enthalpy; lower solver.max_dt or heat.time_scale, or tame the "
+      os << "step " << steps_ + 1 << " (t = " << time_ << " s): particle " << id << " at (" << x[0] << ", "
+         << x[1] << ", " << x[2]
+         << ") m has a non-finite enthalpy; lower solver.max_dt or heat.time_scale, or tame the "
          << "heat sources";
       throw BlowUpError(os.str());
     }
@@ -629,6 +692,14 @@ void Solver::compute_heat(double dt) {
     budget_.dryers += t5[2];
     budget_.walls += t5[3];
     budget_.held += t5[4];
+  }
+  if (rigid_) {
+    cl_uint changed = 0;
+    q.enqueueReadBuffer(phase_changed_, CL_TRUE, 0, 4, &changed);
+    if (changed) {
+      rigid_->note_phase_change();
+      q.enqueueFillBuffer(phase_changed_, cl_uint(0), 0, 4);
+    }
   }
 }
 
@@ -643,16 +714,19 @@ void Solver::step() {
   const bool flow = scene_.solver.flow;
   // Without flow nothing moves: one sort serves the whole run.
   if (flow || !grid_built_) timed(Stage::Grid, [&] { build_grid(); });
+  if (rigid_) timed(Stage::Bodies, [&] { rigid_->relabel_if_due(buffers(), steps_); });
   if (flow) {
     timed(Stage::Density, [&] { compute_density(); });
     timed(Stage::Forces, [&] { compute_forces(); });
   }
+  if (rigid_) timed(Stage::IceForces, [&] { rigid_->compute_forces(buffers()); });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
   if (heat_) {
     timed(Stage::Photons, [&] { trace_photons(dt); });
     timed(Stage::Heat, [&] { compute_heat(dt); });
   }
+  if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
   if (flow) timed(Stage::Integrate, [&] { integrate(dt); });
   time_ += dt;
   dt_ = dt;
@@ -662,8 +736,11 @@ void Solver::step() {
 void Solver::warm_up() {
   // A sort of sorted keys is the identity and dt = 0 leaves x and v unchanged, so this changes no state.
   build_grid();
+  // The first labelling is due before the first step anyway, at these same positions.
+  if (rigid_) rigid_->relabel_if_due(buffers(), steps_);
   compute_density();
   compute_forces();
+  if (rigid_) rigid_->compute_forces(buffers());
   choose_time_step();
   integrate(0.0);
   if (heat_) {
@@ -772,6 +849,12 @@ SimState Solver::state() const {
   s.clamped = clamped();
   s.scene_json = scene_.source.dump();
   if (heat_) s.energy_budget = budget_.to_vector();
+  if (rigid_) {
+    RigidIce::Saved r = rigid_->save(n_);
+    s.rigid_body = std::move(r.body);
+    s.rigid_offset = std::move(r.offset);
+    s.rigid_bodies = std::move(r.bodies);
+  }
   return s;
 }
 

@@ -48,6 +48,8 @@ struct EnergyBudget {
 };
 
 class PhotonTracer;
+class RigidIce;
+struct ParticleBuffers;
 SolverConstants derive_constants(const Scene& scene);
 
 class Solver {
@@ -103,6 +105,9 @@ class Solver {
   void compute_heat(double dt);   // conduction, sources, enthalpy update, phase change, budget
   void integrate(double dt);
 
+  // Rigid ice (scenes with free ice; null otherwise): the bodies, labelling and its counters.
+  const RigidIce* rigid_ice() const { return rigid_.get(); }
+
   // Cell geometry of the neighbour grid (for reference loops and tests).
   struct GridInfo {
     Eigen::Vector3f origin;
@@ -125,6 +130,7 @@ class Solver {
 
  private:
   void compute_boundary_psi();
+  ParticleBuffers buffers() const;
   void upload(const HostParticles& p);
   void upload_dryers();
   double heat_time_step() const;
@@ -171,6 +177,10 @@ class Solver {
   bool dryers_dirty_ = true;
   std::unique_ptr<PhotonTracer> photons_;
   cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_heat_budget_;
+  cl::Buffer phase_changed_;  // set by the heat pass when a particle changed phase
+
+  // Rigid ice (built only when the scene has free ice and flow).
+  std::unique_ptr<RigidIce> rigid_;
 };
 
 // Samples a scene into particles: fluid blocks on a lattice, static solids and domain walls as

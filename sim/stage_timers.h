@@ -7,9 +7,11 @@
 
 namespace thaw {
 
-enum class Stage { Grid, Density, Forces, TimeStep, Photons, Heat, Integrate, Count };
+// IceForces and Bodies run only in scenes with free ice (sim/rigid_ice.h): the forces on ice particles,
+// and labelling, per-body sums, rigid integration and placing the ice particles.
+enum class Stage { Grid, Density, Forces, IceForces, TimeStep, Photons, Heat, Bodies, Integrate, Count };
 inline constexpr std::array<const char*, static_cast<int>(Stage::Count)> kStageNames = {
-    "grid", "density", "forces", "time_step", "photons", "heat", "integrate"};
+    "grid", "density", "forces", "ice_forces", "time_step", "photons", "heat", "bodies", "integrate"};
 
 class StageTimers {
  public:

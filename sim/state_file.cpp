@@ -27,6 +27,7 @@ constexpr std::uint32_t kSectionRequired = 1;
 // A section of the run as a whole (its count is its own, not the particle count).
 constexpr std::uint32_t kSectionGlobal = 2;
 constexpr const char* kEnergySection = "energy_budget";
+constexpr const char* kBodiesSection = "rigid_bodies";
 constexpr std::size_t kPrefixBytes = 8 + 4 + 4;  // magic, version, byte order: the same in every version
 constexpr std::size_t kHeaderBytes = kPrefixBytes + 7 * 8 + 2 * 4 + 8;
 constexpr std::size_t kTrailerBytes = 8;
@@ -146,6 +147,34 @@ void for_each_array(Particles& p, Visit&& visit) {
   visit("enthalpy", p.enthalpy);
 }
 
+// Per-particle arrays that only some runs have: written when they hold one element per particle and
+// not only zeros (a run without fixed ice has no anchored particles), left empty (anchored: all zero)
+// when a file does not have them.
+template <typename State, typename Visit>
+void for_each_optional_array(State& s, Visit&& visit) {
+  visit("anchored", s.particles.anchored);
+  visit("body", s.rigid_body);
+  visit("body_offset", s.rigid_offset);
+}
+
+template <typename Array>
+bool worth_writing(const Array& array, std::size_t n) {
+  using Element = std::remove_cvref_t<decltype(array[0])>;
+  if (array.size() != n || n == 0) return false;
+  if constexpr (std::is_same_v<Element, std::uint8_t>) {  // flags: all clear is the default
+    return std::any_of(array.begin(), array.end(), [](Element e) { return e != Element(0); });
+  } else {
+    return true;
+  }
+}
+
+// Global sections of doubles, written when not empty.
+template <typename State, typename Visit>
+void for_each_global(State& s, Visit&& visit) {
+  visit(kEnergySection, s.energy_budget);
+  visit(kBodiesSection, s.rigid_bodies);
+}
+
 // The arrays of one HostParticles must agree in length before they are written.
 std::optional<std::string> inconsistent_sizes(const HostParticles& p) {
   std::optional<std::string> problem;
@@ -166,10 +195,16 @@ std::string encode_state(const SimState& s) {
     ++sections;
     body += 4 + std::strlen(name) + 4 + 4 + 8 + array.size() * sizeof(array[0]);
   });
-  if (!s.energy_budget.empty()) {
+  for_each_optional_array(s, [&](const char* name, const auto& array) {
+    if (!worth_writing(array, p.size())) return;
     ++sections;
-    body += 4 + std::strlen(kEnergySection) + 4 + 4 + 8 + s.energy_budget.size() * 8;
-  }
+    body += 4 + std::strlen(name) + 4 + 4 + 8 + array.size() * sizeof(array[0]);
+  });
+  for_each_global(s, [&](const char* name, const std::vector<double>& values) {
+    if (values.empty()) return;
+    ++sections;
+    body += 4 + std::strlen(name) + 4 + 4 + 8 + values.size() * 8;
+  });
   const std::size_t total = kHeaderBytes + s.scene_json.size() + body + kTrailerBytes;
 
   ByteWriter w;
@@ -189,7 +224,7 @@ std::string encode_state(const SimState& s) {
   w.u64(fnv1a64(w.buffer()));
 
   w.bytes(s.scene_json);
-  for_each_array(p, [&](const char* name, const auto& array) {
+  auto write_array = [&](const char* name, const auto& array) {
     using Element = std::remove_cvref_t<decltype(array[0])>;
     const std::size_t name_length = std::strlen(name);
     w.u32(static_cast<std::uint32_t>(name_length));
@@ -198,16 +233,21 @@ std::string encode_state(const SimState& s) {
     w.u32(sizeof(Element));
     w.u64(array.size());
     w.words(array.data(), array.size() * sizeof(Element), word_size<Element>());
+  };
+  for_each_array(p, write_array);
+  for_each_optional_array(s, [&](const char* name, const auto& array) {
+    if (worth_writing(array, p.size())) write_array(name, array);
   });
-  if (!s.energy_budget.empty()) {
-    const std::size_t name_length = std::strlen(kEnergySection);
+  for_each_global(s, [&](const char* name, const std::vector<double>& values) {
+    if (values.empty()) return;
+    const std::size_t name_length = std::strlen(name);
     w.u32(static_cast<std::uint32_t>(name_length));
-    w.bytes(std::string_view(kEnergySection, name_length));
+    w.bytes(std::string_view(name, name_length));
     w.u32(kSectionRequired | kSectionGlobal);
     w.u32(8);
-    w.u64(s.energy_budget.size());
-    w.words(s.energy_budget.data(), s.energy_budget.size() * 8, 8);
-  }
+    w.u64(values.size());
+    w.words(values.data(), values.size() * 8, 8);
+  });
   w.u64(fnv1a64(w.buffer()));
   return std::move(w.buffer());
 }
@@ -335,15 +375,16 @@ SimState decode_state(const std::string& path, std::string_view data) {
     seen.push_back(name);
 
     bool known = false;
-    if (name == kEnergySection && (flags & kSectionGlobal)) {
+    for_each_global(s, [&](const char* global_name, std::vector<double>& values) {
+      if (name != global_name || !(flags & kSectionGlobal)) return;
       if (element_size != 8)
         throw file_error(path, "section '" + name + "' has elements of " + std::to_string(element_size) +
                                    " bytes, expected 8");
       known = true;
-      s.energy_budget.resize(static_cast<std::size_t>(count));
-      copy_little_endian(reinterpret_cast<char*>(s.energy_budget.data()), payload.data(), payload.size(), 8);
-    }
-    for_each_array(s.particles, [&](const char* array_name, auto& array) {
+      values.resize(static_cast<std::size_t>(count));
+      copy_little_endian(reinterpret_cast<char*>(values.data()), payload.data(), payload.size(), 8);
+    });
+    auto read_array = [&](const char* array_name, auto& array) {
       using Element = std::remove_cvref_t<decltype(array[0])>;
       if (name != array_name) return;
       known = true;
@@ -356,9 +397,12 @@ SimState decode_state(const std::string& path, std::string_view data) {
                                    std::to_string(count) + " elements, header says " + std::to_string(n) +
                                    " particles");
       }
+      array.resize(static_cast<std::size_t>(n));
       copy_little_endian(reinterpret_cast<char*>(array.data()), payload.data(), payload.size(),
                          word_size<Element>());
-    });
+    };
+    for_each_array(s.particles, read_array);
+    for_each_optional_array(s, read_array);
     if (!known && (flags & kSectionRequired)) {
       throw file_error(path, "unknown required section '" + name +
                                  "' (written by a newer thaw; this build cannot resume it)");

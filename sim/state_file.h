@@ -21,8 +21,10 @@
 //   sections       each: name length u32, name, flags u32 (bit 0: required; bit 1: global, i.e. a
 //                  record of the run whose count is its own, not the particle count), element size u32,
 //                  count u64, count * element size bytes. Per particle: position, velocity, density,
-//                  phase, material, id, enthalpy (two floats: hi, lo). Global: energy_budget (doubles,
-//                  only in runs with heat).
+//                  phase, material, id, enthalpy (two floats: hi, lo); where present, anchored (u8:
+//                  particles of fixed ice objects), body (u32) and body_offset (four floats) of runs
+//                  with free ice. Global: energy_budget (doubles, only in runs with heat),
+//                  rigid_bodies (doubles, only in runs with free ice).
 //   checksum       u64      FNV-1a-64 of every byte before it
 // Arrays are named sections so later versions can add per-particle fields (temperature, enthalpy,
 // body id) without breaking readers: a reader skips unknown optional sections and refuses unknown
@@ -48,6 +50,12 @@ struct SimState {
   // The run's energy account [J] (sim/solver.h, EnergyBudget::to_vector); empty without heat. Stored as
   // the section "energy_budget" (flags: required, global), whose count is its own.
   std::vector<double> energy_budget;
+  // Rigid ice (sim/rigid_ice.h), in runs with free ice only: per particle in the same order as
+  // `particles`, the body index and the body-frame offset (sections "body", "body_offset"), and the
+  // bodies with their labelling schedule (global section "rigid_bodies"). Empty otherwise.
+  std::vector<std::uint32_t> rigid_body;
+  std::vector<Float4> rigid_offset;
+  std::vector<double> rigid_bodies;
 };
 
 // Writes `state` to `path` atomically and durably; throws thaw::Error naming the path and the reason.

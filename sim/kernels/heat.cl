@@ -125,7 +125,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
                  const float H, const float eta2, const float4 period, const float exposed_r2,
                  const float face_area, const float ambient_temperature, const float ambient_coefficient,
                  global const DryerJet* dryers, const uint ndryers, global float* lamp_energy,
-                 const float dt_heat, global float* budget, const uint n) {
+                 const float dt_heat, global float* budget, global uint* phase_changed, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   const float4 pi = pos[i];
@@ -204,7 +204,11 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
     phase[i] = (uchar)to;
     material[i] = (uchar)m.partner;
     pos[i] = (float4)(pi.xyz, mass / other.thermal_mass_scale);
-    vel[i] = (float4)(0.0f);
+    /* Melted ice flows on with the velocity its body gave it; frozen water stands still until a body
+     * adopts it (sim/rigid_ice.h). */
+    if (to == THAW_PHASE_ICE) vel[i] = (float4)(0.0f);
+    /* Every work-item that writes stores the same value: no atomic needed. */
+    *phase_changed = 1u;
   }
 
   budget[THAW_SRC_AMBIENT * stride + i] = e_ambient;

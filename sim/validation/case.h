@@ -50,6 +50,8 @@ ValidationCase hydrostatic_case();
 ValidationCase dam_break_case();
 ValidationCase conduction_case();
 ValidationCase stefan_case();
+ValidationCase rigid_spin_case();
+ValidationCase floating_case();
 
 }  // namespace thaw
 

@@ -2,13 +2,19 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "sim/error.h"
+#include "sim/geometry/voxelize.h"
+#include "sim/solver.h"
+#include "tests/test_support.h"
 
 namespace thaw {
 namespace {
@@ -139,9 +145,10 @@ TEST(Scene, ConvertsEveryField) {
   EXPECT_EQ(s.fluids[1].velocity, Eigen::Vector3d(1, 0, 0));
   EXPECT_EQ(s.fluids[1].box.min, Eigen::Vector3d(0.2, 0, 0));
   ASSERT_EQ(s.solids.size(), 2u);
-  EXPECT_EQ(s.solids[0].shape, Solid::Shape::Box);
+  EXPECT_FALSE(s.solids[0].plane);
+  EXPECT_TRUE(s.solids[0].shape.axis_aligned_box());
   EXPECT_EQ(s.solids[0].box.max, Eigen::Vector3d(0.18, 0.2, 0.05));
-  EXPECT_EQ(s.solids[1].shape, Solid::Shape::Plane);
+  EXPECT_TRUE(s.solids[1].plane);
   EXPECT_EQ(s.solids[1].normal, Eigen::Vector3d(0, 0, 1));  // normalised
   EXPECT_EQ(s.domain.max, Eigen::Vector3d(0.4, 0.2, 0.3));
 }
@@ -376,6 +383,202 @@ TEST(SceneError, SpacingAgainstTheDomain) {
 
 TEST(SceneError, TimeStepLimitsInOrder) {
   EXPECT_EQ(override_error("solver.min_dt=0.01").path(), "solver.min_dt");
+}
+
+// ---- shapes ------------------------------------------------------------------------------------------
+
+// The base scene at 5 mm with an ice material and the given ice entries.
+Json scene_with_ice(const std::string& ice) {
+  Json doc = base_scene();
+  doc["spacing"] = 0.005;
+  doc["materials"]["ice"] = Json::parse(
+      R"({"kind": "ice", "density": 917, "conductivity": 2.22, "specific_heat": 2050, "melts_into": "water"})");
+  doc["ice"] = Json::parse(ice);
+  return doc;
+}
+
+// One of each shape, clear of each other, the solids and the fluids; the last (the bunny) free.
+const char* kEveryShape = R"([
+  {"material": "ice", "box": {"min": [0.02, 0.02, 0.15], "max": [0.06, 0.06, 0.19]}},
+  {"material": "ice", "box": {"min": [0.02, 0.1, 0.15], "max": [0.06, 0.14, 0.19]}, "rotation": [0, 0, 45]},
+  {"material": "ice", "shape": "sphere", "centre": [0.1, 0.05, 0.2], "radius": 0.02},
+  {"material": "ice", "shape": "cylinder", "from": [0.2, 0.05, 0.15], "to": [0.2, 0.05, 0.25], "radius": 0.01},
+  {"material": "ice", "shape": "cone", "from": [0.25, 0.05, 0.25], "to": [0.25, 0.05, 0.15], "radius": 0.01},
+  {"material": "ice", "shape": "capsule", "from": [0.3, 0.05, 0.15], "to": [0.35, 0.05, 0.15], "radius": 0.01},
+  {"material": "ice", "shape": "mesh", "mesh": "meshes/bunny.obj", "centre": [0.3, 0.14, 0.2], "size": 0.06,
+   "rotation": [90, 0, 0], "motion": "free"}
+])";
+
+TEST(SceneShapes, IceOfEveryShapeIsSampledAndOnlyFixedIceIsAnchored) {
+  const Scene s = scene_from_json(scene_with_ice(kEveryShape));
+  ASSERT_EQ(s.ice.size(), 7u);
+  EXPECT_TRUE(s.ice[0].shape.axis_aligned_box());
+  EXPECT_FALSE(s.ice[1].shape.axis_aligned_box());
+  EXPECT_EQ(s.ice[2].shape.kind(), Shape::Kind::Sphere);
+  EXPECT_EQ(s.ice[4].shape.kind(), Shape::Kind::Cone);
+  EXPECT_EQ(s.ice[6].shape.kind(), Shape::Kind::Mesh);
+  EXPECT_EQ(s.ice[0].motion, IceBlock::Motion::Fixed);
+  EXPECT_EQ(s.ice[6].motion, IceBlock::Motion::Free);
+  EXPECT_NEAR(s.ice[2].box.min.z(), 0.18, 1e-15);  // the bounding box
+  EXPECT_NEAR(s.ice[6].box.max.x() - s.ice[6].box.min.x(), 0.06, 1e-12);
+  // The mesh was found in configs/, and the source says where.
+  EXPECT_EQ(s.source["ice"][6]["mesh"],
+            (kSource / "configs" / "meshes" / "bunny.obj").lexically_normal().string());
+  EXPECT_EQ(s.source["ice"][0]["shape"], "box");
+  EXPECT_EQ(s.source["ice"][0]["motion"], "fixed");
+
+  const HostParticles p = sample_scene(s);
+  ASSERT_EQ(p.anchored.size(), p.size());
+  std::size_t fixed = 0;
+  for (std::size_t b = 0; b + 1 < s.ice.size(); ++b) {
+    const std::size_t n = voxelize(s.ice[b].shape, s.spacing, &s.domain.min).size();
+    EXPECT_GT(n, 10u) << "ice[" << b << "]";
+    fixed += n;
+  }
+  const std::size_t bunny = voxelize(s.ice[6].shape, s.spacing, &s.domain.min).size();
+  EXPECT_GT(bunny, 300u);
+  ASSERT_EQ(p.count(Phase::Ice), fixed + bunny);
+  // Ice comes after the boundary particles, in the order of its entries.
+  std::size_t first = 0;
+  while (p.phase[first] != std::uint8_t(Phase::Ice)) ++first;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const bool fixed_ice = i >= first && i < first + fixed;
+    ASSERT_EQ(p.anchored[i], fixed_ice ? 1 : 0) << "particle " << i;
+    if (fixed_ice) {
+      ASSERT_EQ(p.phase[i], std::uint8_t(Phase::Ice));
+    }
+  }
+}
+
+TEST(SceneShapes, LaterIceAndFluidsSkipWhatIsAlreadyFilled) {
+  Json doc = scene_with_ice(R"([
+    {"material": "ice", "shape": "sphere", "centre": [0.05, 0.05, 0.05], "radius": 0.03},
+    {"material": "ice", "shape": "sphere", "centre": [0.08, 0.05, 0.05], "radius": 0.02}
+  ])");
+  doc["solids"][0] = Json::parse(
+      R"({"shape": "capsule", "material": "glass", "from": [0.25, 0.05, 0.05], "to": [0.25, 0.05, 0.09], "radius": 0.02})");
+  const Scene s = scene_from_json(doc);
+  const HostParticles p = sample_scene(s);
+  // All lattices here line up (every bounding box starts on a multiple of 5 mm), so an overlap would
+  // put two particles on one point.
+  std::set<std::array<long, 3>> seen;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.phase[i] == std::uint8_t(Phase::Solid)) continue;  // the base scene's plane and -z wall coincide
+    const Float4& x = p.position[i];
+    ASSERT_TRUE(
+        seen.insert({std::lround(x[0] / 1e-4), std::lround(x[1] / 1e-4), std::lround(x[2] / 1e-4)}).second)
+        << x[0] << " " << x[1] << " " << x[2];
+  }
+  const std::vector<Eigen::Vector3d> first = voxelize(s.ice[0].shape, s.spacing);
+  const std::vector<Eigen::Vector3d> second = voxelize(s.ice[1].shape, s.spacing);
+  const auto second_only = std::size_t(std::count_if(
+      second.begin(), second.end(), [&](const Eigen::Vector3d& x) { return !s.ice[0].shape.contains(x); }));
+  EXPECT_LT(second_only, second.size());
+  EXPECT_EQ(p.count(Phase::Ice), first.size() + second_only);
+  // The capsule's boundary particles are a shell, and no water sits inside it.
+  const std::size_t shell = voxelize_shell(s.solids[0].shape, s.spacing, wall_layer_count(s)).size();
+  EXPECT_LT(shell, voxelize(s.solids[0].shape, s.spacing).size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.phase[i] != std::uint8_t(Phase::Water)) continue;
+    const Eigen::Vector3d x(p.position[i][0], p.position[i][1], p.position[i][2]);
+    ASSERT_FALSE(s.solids[0].shape.contains(x)) << x.transpose();
+    ASSERT_FALSE(s.ice[0].shape.contains(x)) << x.transpose();
+  }
+}
+
+TEST(SceneShapes, ExistingIceBlocksKeepTheirMeaning) {
+  const Scene s = load_scene("default");
+  const Json& ice = s.source["ice"];
+  ASSERT_EQ(s.ice.size(), ice.size());
+  for (std::size_t i = 0; i < s.ice.size(); ++i) {
+    EXPECT_TRUE(s.ice[i].shape.axis_aligned_box());
+    EXPECT_EQ(s.ice[i].motion, IceBlock::Motion::Fixed);
+    const Json& min = ice[i]["box"]["min"];
+    EXPECT_EQ(s.ice[i].box.min,
+              Eigen::Vector3d(min[0].get<double>(), min[1].get<double>(), min[2].get<double>()));
+  }
+}
+
+TEST(SceneShapes, MeshPathIsRelativeToTheSceneFile) {
+  testing::TempDir dir("scene-mesh");
+  fs::create_directories(dir.path() / "shapes");
+  testing::write_text(dir.path() / "shapes" / "cube.obj",
+                      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                      "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
+                      "f 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+  Json doc = scene_with_ice(
+      R"([{"material": "ice", "shape": "mesh", "mesh": "shapes/cube.obj", "centre": [0.05, 0.05, 0.2], "size": 0.04}])");
+  testing::write_text(dir.path() / "scene.json", doc.dump(2));
+  const Scene s = load_scene(dir / "scene.json");
+  EXPECT_EQ(s.source["ice"][0]["mesh"], (dir.path() / "shapes" / "cube.obj").string());
+  EXPECT_NEAR(s.ice[0].shape.volume(), 0.04 * 0.04 * 0.04, 1e-12);
+  // The source reloads from anywhere: its path is absolute.
+  EXPECT_NO_THROW(scene_from_json(s.source));
+  // The same document read from elsewhere does not find the mesh, and says where it looked.
+  const SceneError e = scene_error(doc);
+  EXPECT_EQ(e.path(), "ice[0].mesh");
+  EXPECT_NE(message(e).find("'shapes/cube.obj' not found; looked for"), std::string::npos) << e.what();
+  EXPECT_NE(message(e).find((kSource / "configs" / "shapes" / "cube.obj").string()), std::string::npos)
+      << e.what();
+}
+
+TEST(SceneError, BrokenMeshNamesTheFieldAndTheFile) {
+  testing::TempDir dir("scene-broken-mesh");
+  testing::write_text(dir.path() / "broken.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\n");
+  const std::string file = dir / "broken.stl";
+  const SceneError e =
+      scene_error(scene_with_ice(R"([{"material": "ice", "shape": "mesh", "mesh": ")" + file +
+                                 R"(", "centre": [0.05, 0.05, 0.2], "size": 0.04}])"));
+  EXPECT_EQ(e.path(), "ice[0].mesh");
+  EXPECT_NE(message(e).find(file), std::string::npos) << e.what();
+}
+
+TEST(SceneError, ShapeFieldsAreCheckedAtTheirPaths) {
+  struct Case {
+    const char* ice;
+    const char* path;
+    const char* says;
+  };
+  const Case cases[] = {
+      {R"({"material": "ice", "shape": "sphear", "centre": [0.1, 0.1, 0.2], "radius": 0.01})", "ice[1].shape",
+       "did you mean 'sphere'"},
+      {R"({"material": "ice", "shape": "sphere", "centre": [0.1, 0.1, 0.2]})", "ice[1].radius",
+       "missing: required when shape is 'sphere'"},
+      {R"({"material": "ice", "shape": "sphere", "centre": [0.1, 0.1, 0.2], "radius": -0.01})",
+       "ice[1].radius", "out of range"},
+      {R"({"material": "ice", "box": {"min": [0.1, 0.1, 0.2], "max": [0.12, 0.12, 0.22]}, "radius": 0.01})",
+       "ice[1].radius", "only allowed when shape is 'sphere', 'cylinder', 'cone' or 'capsule'"},
+      {R"({"material": "ice", "shape": "sphere", "centre": [0.1, 0.1, 0.2], "radius": 0.01, "rotation": [0, 0, 1]})",
+       "ice[1].rotation", "only allowed when shape is 'box' or 'mesh'"},
+      {R"({"material": "ice", "shape": "cone", "from": [0.1, 0.1, 0.2], "to": [0.1, 0.1, 0.2], "radius": 0.01})",
+       "ice[1].to", "no length"},
+      {R"({"material": "ice", "shape": "capsule", "from": [0.1, 0.1, 0.2], "radius": 0.01})", "ice[1].to",
+       "missing: required when shape is 'capsule'"},
+      {R"({"material": "ice", "shape": "mesh", "mesh": "meshes/bunny.obj", "centre": [0.1, 0.1, 0.2]})",
+       "ice[1].size", "required when shape is 'mesh'"},
+      {R"({"material": "ice", "shape": "mesh", "mesh": "meshes/nowhere.obj", "centre": [0.1, 0.1, 0.2], "size": 0.02})",
+       "ice[1].mesh", "'meshes/nowhere.obj' not found"},
+      {R"({"material": "ice", "shape": "sphere", "centre": [0.1, 0.1, 0.29], "radius": 0.02})", "ice[1]",
+       "outside the domain along z"},
+      {R"({"material": "ice", "shape": "sphere", "centre": [0.1, 0.1, 0.2], "radius": 0.01, "motion": "loose"})",
+       "ice[1].motion", "not one of 'fixed', 'free'"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.ice);
+    const std::string ice =
+        std::string(R"([{"material": "ice", "box": {"min": [0.3, 0.1, 0.2], "max": [0.32, 0.12, 0.22]}}, )") +
+        c.ice + "]";
+    const SceneError e = scene_error(scene_with_ice(ice));
+    EXPECT_EQ(e.path(), c.path) << e.what();
+    EXPECT_NE(message(e).find(c.says), std::string::npos) << e.what();
+  }
+  // Solids take the same shapes, and planes none of their fields.
+  Json doc = base_scene();
+  doc["solids"].push_back(Json::parse(R"({"shape": "sphere", "material": "glass", "radius": 0.01})"));
+  EXPECT_EQ(scene_error(doc).path(), "solids[2].centre");
+  doc = base_scene();
+  doc["solids"][1]["radius"] = 0.01;
+  EXPECT_EQ(scene_error(doc).path(), "solids[1].radius");
 }
 
 // ---- files -------------------------------------------------------------------------------------------

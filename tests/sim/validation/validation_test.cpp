@@ -136,5 +136,22 @@ TEST(ValidateCli, BadCaseParameterNamesItsPath) {
   EXPECT_NE(r.err.find("heigth"), std::string::npos) << r.err;
 }
 
+// Rigid-body dynamics alone (no device work): each axis for the default 20 revolutions at a CI size.
+TEST_F(Validation, RigidSpinKeepsItsInvariantsAndFlipsOnlyTheIntermediateAxis) {
+  for (const std::string axis : {"min", "intermediate", "max"}) {
+    const CaseResult r = run_validation(cl(), "rigid-spin", 10, {"axis=" + axis});
+    print(r);
+    EXPECT_TRUE(r.passed()) << axis;
+    ASSERT_EQ(r.metrics.size(), 7u);
+    EXPECT_EQ(r.metrics.back().first, axis == "intermediate" ? "axis_flip" : "axis_wander");
+  }
+  // The references follow the parameters: a faster spin of another box still passes against its own.
+  const CaseResult r = run_validation(cl(), "rigid-spin", 12,
+                                      {"a=0.05", "b=0.02", "c=0.035", "spin=3", "dt=1e-4", "revolutions=10"});
+  print(r);
+  EXPECT_TRUE(r.passed());
+  EXPECT_THROW(run_validation(cl(), "rigid-spin", 10, {"b=0.04"}), SceneError);
+}
+
 }  // namespace
 }  // namespace thaw

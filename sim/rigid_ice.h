@@ -1,0 +1,125 @@
+#pragma once
+// Ice that moves (Iwasaki et al. 2010 sec. 5-6): each connected piece of ice is a rigid body. The
+// stage labels the ice's connected components on the device, turns each into a body (mass, centre,
+// principal inertia, the rigid motion its particles carry), and each step sums the forces on its
+// particles (water pressure and viscosity, contacts with solids and other bodies), integrates the
+// bodies on the host and moves the particles with their bodies.
+//
+// A body is fixed when any of its particles comes from an ice object with "motion": "fixed" (an
+// icicle's root, a pedestal glued to the floor); the rest are free. Labels are recomputed after the
+// neighbour sort of a step that follows a phase change of ice (melting can cut a body in two, freezing
+// can join two), at most every `relabel_interval` steps; between labellings a melted particle leaves
+// its body at once and a frozen one stays in place until the next labelling adopts it.
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/cl_grid.h"
+#include "sim/cl_runtime.h"
+#include "sim/ice_bodies.h"
+#include "sim/particles.h"
+#include "sim/rigid_body.h"
+#include "sim/scene.h"
+
+namespace thaw {
+
+// The solver's per-particle device buffers in their current (sorted) order, and the grid over them.
+struct ParticleBuffers {
+  const cl::Buffer& position;
+  const cl::Buffer& velocity;
+  const cl::Buffer& state;  // (rho, p / rho^2, is_boundary, p) from the density pass
+  const cl::Buffer& phase;
+  const cl::Buffer& material;
+  const cl::Buffer& id;
+  const cl::Buffer& cell_start;
+  ClGrid grid;
+  std::uint32_t n = 0;
+};
+
+// Contact between ice and solids or other ice bodies (Tanaka et al. 2007 as Iwasaki 2010 cites; see
+// sim/kernels/rigid.cl).
+struct ContactModel {
+  double stiffness = 0;  // k_n [N/m]
+  double damping = 0;    // c_n [N s/m]
+  double friction = 0;   // Coulomb mu
+  double distance = 0;   // contact diameter [m]
+};
+
+// One body as the metrics and tests see it.
+struct IceBody {
+  std::uint32_t label = 0;  // the largest particle id in the body: stable while that particle is ice
+  std::size_t particles = 0;
+  double radius = 0;  // the farthest particle from the centre of mass [m]
+  RigidBody body;
+};
+
+class RigidIce {
+ public:
+  struct Settings {
+    double spacing = 0;        // particle spacing dx [m]
+    double support = 0;        // kernel support H [m]
+    double smoothing = 0;      // h [m] (viscosity's eps h^2)
+    double visc_boundary = 0;  // the forces pass's boundary viscosity coefficient
+    Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+    ContactModel contact;
+    int relabel_interval = 10;  // steps between labellings while ice changes phase
+    int grid_reach = 1;         // cells the neighbour walk visits on each side (Solver::GridInfo::reach)
+  };
+
+  // `build_options` are the solver's program options (kernel, lanes, reach); `anchored_by_id[id]` is 1
+  // for particles of fixed ice objects; `mass_scale[material]` turns a particle's SPH mass into its
+  // physical mass (ice is sampled with the fluid's rest mass; sim/thermal.h).
+  RigidIce(ClRuntime& cl, const std::string& build_options, std::size_t n, Settings settings,
+           std::vector<std::uint8_t> anchored_by_id, std::vector<float> mass_scale);
+  ~RigidIce();
+
+  // The body index and offset of each particle follow the neighbour sort's permutation.
+  void reorder(const cl::Buffer& order, std::uint32_t n);
+  // After the sort: labels the ice into bodies when a phase change of ice asked for it (or `force`).
+  void relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool force = false);
+  // After the density pass: the force on each ice particle of a free body.
+  void compute_forces(const ParticleBuffers& p);
+  // The fastest point of any free body [m/s] (the time step's CFL limit covers it).
+  double max_point_speed() const;
+  // Sums the forces per body, integrates the bodies over dt and moves their particles.
+  void advance(const ParticleBuffers& p, double dt);
+  // The heat stage saw ice change phase this step.
+  void note_phase_change() { phase_changed_ = true; }
+
+  const std::vector<IceBody>& bodies() const { return bodies_; }
+  std::uint64_t labellings() const { return labellings_; }
+  int last_iterations() const { return last_iterations_; }
+
+  // State for state files: per particle (sorted order) the body index and body-frame offset; the bodies
+  // and the labelling schedule as doubles.
+  struct Saved {
+    std::vector<std::uint32_t> body;
+    std::vector<Float4> offset;
+    std::vector<double> bodies;
+  };
+  Saved save(std::size_t n) const;
+  void restore(const Saved& s, std::size_t n);
+
+ private:
+  void upload_bodies();
+
+  ClRuntime& cl_;
+  Settings settings_;
+  std::vector<std::uint8_t> anchored_by_id_;
+  std::vector<float> mass_scale_;
+  std::unique_ptr<IceLabeller> labeller_;
+  std::unique_ptr<BodyReducer> reducer_;
+  cl::Kernel k_forces_, k_place_, k_reorder_;
+  cl::Buffer body_, spare_body_, offset_, spare_offset_, force_, label_, bodies_dev_, refs_;
+  std::size_t bodies_capacity_ = 0;
+  std::vector<IceBody> bodies_;
+  bool phase_changed_ = false;
+  bool labelled_ = false;
+  std::uint64_t labelled_step_ = 0;
+  std::uint64_t labellings_ = 0;
+  int last_iterations_ = 0;
+};
+
+}  // namespace thaw
