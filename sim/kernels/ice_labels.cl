@@ -16,6 +16,12 @@
 
 #define THAW_NO_LABEL 0xffffffffu
 
+/* Particles per work-item of a sweep (the host sets it): most are not ice and take a few instructions,
+ * so one work-item each spent more in pocl's per-item overhead than in the work. */
+#ifndef THAW_SWEEP_TILE
+#define THAW_SWEEP_TILE 16
+#endif
+
 /* The ice particles' coordinates as x, y, z blocks of `stride` floats for the lanes of ice_neighbours; NaN
  * for other phases and the padding (up to THAW_VW - 1 past the last particle is read), so their distance
  * test fails without a phase test. */
@@ -112,32 +118,38 @@ kernel void label_slots(global const uint* id, global uint* slot_of, const uint 
  * atomic_max (only where that particle is another one and lags: the plain reads first skip most), whose
  * final value is the same whatever order they come in; hook_in, last sweep's, is not written in this one.
  * With label_in read only (Jacobi), the sweep count and the result do not depend on the order work-items
- * run in. changed[0] is set (a plain store: every writer writes 1) when a label rose. */
+ * run in. changed[0] is set (a plain store: every writer writes 1) when a label rose. Each work-item
+ * sweeps THAW_SWEEP_TILE consecutive particles. */
 kernel void propagate_labels(global const uint* degree, global const uint* edges, const uint width,
                              global const uint* slot_of, global const uint* label_in, global uint* label_out,
                              const uint jumps, const uint hook, global const uint* hook_in,
                              volatile global uint* hook_out, global uint* changed, const uint n) {
-  const uint i = get_global_id(0);
-  if (i >= n) return;
-  const uint own = label_in[i];
-  uint l = own;
-  if (own != THAW_NO_LABEL) {
-    if (hook) l = max(l, hook_in[i]);
-    global const uint* row = edges + (size_t)i * width;
-    const uint e = degree[i];
-    for (uint k = 0; k < e; ++k) l = max(l, label_in[row[k]]);
-    for (uint h = 0; h < jumps; ++h) {
-      const uint m = label_in[slot_of[l]];
-      if (m <= l) break;
-      l = m;
-    }
-    if (l != own) {
-      changed[0] = 1u;
-      if (hook) {
-        const uint r = slot_of[own];
-        if (r != i && label_in[r] < l && hook_out[r] < l) atomic_max(&hook_out[r], l);
+  const uint b = get_global_id(0) * THAW_SWEEP_TILE;
+  if (b >= n) return;
+  const uint e = min(n, b + THAW_SWEEP_TILE);
+  uint rose = 0;
+  for (uint i = b; i < e; ++i) {
+    const uint own = label_in[i];
+    uint l = own;
+    if (own != THAW_NO_LABEL) {
+      if (hook) l = max(l, hook_in[i]);
+      global const uint* row = edges + (size_t)i * width;
+      const uint d = degree[i];
+      for (uint k = 0; k < d; ++k) l = max(l, label_in[row[k]]);
+      for (uint h = 0; h < jumps; ++h) {
+        const uint m = label_in[slot_of[l]];
+        if (m <= l) break;
+        l = m;
+      }
+      if (l != own) {
+        rose = 1u;
+        if (hook) {
+          const uint r = slot_of[own];
+          if (r != i && label_in[r] < l && hook_out[r] < l) atomic_max(&hook_out[r], l);
+        }
       }
     }
+    label_out[i] = l;
   }
-  label_out[i] = l;
+  if (rose) changed[0] = 1u;
 }
