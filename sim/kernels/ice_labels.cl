@@ -7,8 +7,8 @@
  *   propagate_labels  one Jacobi sweep of max propagation with pointer jumps (and hooks), until nothing
  *                     changes
  * The neighbour lists are built once per labelling (one grid walk, into rows of a fixed width the host
- * widens when a particle has more): each sweep then reads a few neighbours rather than walking every
- * candidate of 27 cells again. */
+ * widens when a particle has more): each sweep then reads a few neighbours rather than walking the cells
+ * again. */
 
 /* The pair test, (dx dx + dy dy) + dz dz < r2, must give the same answer on the host (tests, reference
  * loops) as here: no fused multiply-add. */

@@ -96,5 +96,111 @@ TEST_F(RigidIceTest, IceAndWaterKeepTheirTotalMomentumWithoutGravity) {
   EXPECT_LT(std::abs(now.angular_velocity().z()), 2.0);  // the spin is damped, never pumped
 }
 
+// Two ice cubes joined by a neck two particles long, in zero gravity without water, warm enough in the
+// neck to melt at once: one body before, two after the next labelling, whose masses add up to the ice
+// that is left.
+Json dumbbell_scene() {
+  const double dx = 0.004;
+  auto cube = [&](double x0) { return box(x0, 0, 0, x0 + 4 * dx, 4 * dx, 4 * dx); };
+  return {{"name", "dumbbell"},
+          {"domain", box(-0.02, -0.02, -0.02, 0.06, 0.04, 0.04)},
+          {"gravity", {0, 0, 0}},
+          {"spacing", dx},
+          {"ambient", {{"heat_transfer_coefficient", 0.0}}},
+          {"materials", materials()},
+          {"ice",
+           {{{"material", "ice"}, {"box", cube(0)}, {"motion", "free"}, {"temperature", 0.0}},
+            {{"material", "ice"}, {"box", box(4 * dx, dx, dx, 6 * dx, 2 * dx, 2 * dx)}, {"motion", "free"},
+             {"temperature", 0.0}},
+            {{"material", "ice"}, {"box", cube(6 * dx)}, {"motion", "free"}, {"temperature", 0.0}}}}};
+}
+
+TEST_F(RigidIceTest, AMeltedNeckCutsADumbbellIntoTwoBodies) {
+  const Scene scene = scene_from_json(dumbbell_scene());
+  SimState st = initial_state(scene);
+  const double dx = scene.spacing;
+  std::size_t neck = 0;
+  for (std::size_t i = 0; i < st.particles.size(); ++i) {
+    const double x = st.particles.position[i][0];
+    if (st.particles.phase[i] == std::uint8_t(Phase::Ice) && x > 4 * dx && x < 6 * dx) {
+      st.particles.enthalpy[i] = {float(1.01 * 334000.0), 0.f};  // past the latent heat: melts at once
+      ++neck;
+    }
+  }
+  ASSERT_EQ(neck, 2u);
+  Solver solver(cl(), scene, st);
+  solver.warm_up();
+  ASSERT_TRUE(solver.rigid_ice());
+  ASSERT_EQ(solver.rigid_ice()->bodies().size(), 1u);
+  const double whole = solver.rigid_ice()->bodies()[0].body.mass;
+  for (int k = 0; k < 15; ++k) solver.step();
+  const auto& bodies = solver.rigid_ice()->bodies();
+  ASSERT_EQ(bodies.size(), 2u);
+  const Metrics m = measure(solver);
+  EXPECT_EQ(bodies[0].particles, 64u);
+  EXPECT_EQ(bodies[1].particles, 64u);
+  EXPECT_NEAR(bodies[0].body.mass + bodies[1].body.mass, m.ice_mass, 1e-9 * m.ice_mass);
+  EXPECT_NEAR(whole - m.ice_mass, 2 * 917.0 * dx * dx * dx, 1e-6 * whole);
+  EXPECT_NEAR(bodies[0].body.mass, bodies[1].body.mass, 1e-12);
+  EXPECT_GE(solver.rigid_ice()->labellings(), 2u);
+  std::printf("labelling sweeps for the split: %d\n", solver.rigid_ice()->last_iterations());
+}
+
+// An ice block dropped onto the tank's floor in air comes to rest on it, a contact distance above
+// the wall particles, without passing into them.
+TEST_F(RigidIceTest, IceRestsOnTheFloorWithoutPassingThrough) {
+  const double dx = 0.004;
+  Json doc = {{"name", "drop"},
+              {"domain", {{"min", {0, 0, 0}}, {"max", {0.04, 0.04, 0.06}}, {"walls", {"-z"}}, {"wall_material", "wall"}}},
+              {"spacing", dx},
+              {"heat", {{"enabled", false}}},
+              {"materials", materials()},
+              {"fluids", Json::array()},
+              {"ice", {{{"material", "ice"}, {"box", box(0.012, 0.012, 0.02, 0.028, 0.028, 0.036)}, {"motion", "free"}}}}};
+  // No fluid to set the speed of sound: give the contact springs one.
+  doc["solver"] = {{"speed_of_sound", 10.0}};
+  const Scene scene = scene_from_json(doc);
+  Solver solver(cl(), scene, initial_state(scene));
+  solver.warm_up();
+  double lowest = 1e9;
+  while (solver.time() < 0.4) {
+    solver.step();
+    const HostParticles p = solver.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.phase[i] == std::uint8_t(Phase::Ice)) lowest = std::min(lowest, double(p.position[i][2]));
+  }
+  const RigidBody& b = solver.rigid_ice()->bodies().at(0).body;
+  // The floor's top wall layer sits at -dx/2; the contact keeps ice particles a spacing above it.
+  EXPECT_GT(lowest, 0.4 * dx) << "ice passed into the floor";
+  EXPECT_LT(std::abs(b.velocity.z()), 0.02) << "not at rest";
+  // Resting: its lowest layer a contact distance (dx) above the wall's top layer (-dx/2), so its centre,
+  // 1.5 spacings above that layer, at 2 dx; the springs give way by a few micrometres under its weight.
+  EXPECT_NEAR(b.position.z(), 2 * dx, 0.05 * dx);
+}
+
+// A run with rigid ice resumed from a state file continues bitwise identically.
+TEST_F(RigidIceTest, ResumingFromAStateFileIsBitwiseIdentical) {
+  TempDir dir("rigid-resume");
+  const Scene scene = scene_from_json(dumbbell_scene());
+  SimState st = initial_state(scene);
+  for (std::size_t i = 0; i < st.particles.size(); ++i)
+    if (st.particles.phase[i] == std::uint8_t(Phase::Ice))
+      st.particles.velocity[i] = {0.01f, 0.f, 0.002f * float(st.particles.position[i][0]) * 100.f, 0.f};
+  Solver a(cl(), scene, st);
+  for (int k = 0; k < 8; ++k) a.step();
+  const std::string path = (dir.path() / "mid.state").string();
+  write_state_file(path, a.state());
+  for (int k = 0; k < 8; ++k) a.step();
+  Solver b(cl(), scene, read_state_file(path));
+  for (int k = 0; k < 8; ++k) b.step();
+  const SimState sa = a.state(), sb = b.state();
+  EXPECT_EQ(sa.particles.position, sb.particles.position);
+  EXPECT_EQ(sa.particles.velocity, sb.particles.velocity);
+  EXPECT_EQ(sa.rigid_body, sb.rigid_body);
+  EXPECT_EQ(sa.rigid_offset, sb.rigid_offset);
+  EXPECT_EQ(sa.rigid_bodies, sb.rigid_bodies);
+  EXPECT_FALSE(sa.rigid_bodies.empty());
+}
+
 }  // namespace
 }  // namespace thaw
