@@ -1,7 +1,9 @@
 #pragma once
-// Weakly compressible SPH water with static boundary particles, and heat with phase change, stepped on an
-// OpenCL device. One step (see Solver::step): grid -> density -> forces -> time step -> photons -> heat ->
-// integrate; a scene without heat builds no heat stages, one with the flow off none of the fluid ones.
+// Weakly compressible SPH water with static boundary particles, heat with phase change, and ice as rigid
+// bodies, stepped on an OpenCL device. One step (see Solver::step): grid -> [ice labels] -> density ->
+// forces -> [ice forces] -> time step -> photons -> heat -> [bodies] -> integrate; a scene without heat
+// builds no heat stages, one without free ice no rigid stages (sim/rigid_ice.h), one with the flow off
+// none of the fluid ones.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -18,13 +20,13 @@ namespace thaw {
 
 // Constants the scene implies, derived once (speed of sound, kernel radius, EOS stiffness).
 struct SolverConstants {
-  float support = 0;         // kernel support radius H [m]
-  float smoothing = 0;       // h = H / 2 (CFL and viscosity length) [m]
-  float rest_density = 0;    // rho0 of the fluid [kg/m^3]
-  float sound_speed = 0;     // c [m/s]
-  float stiffness = 0;       // Tait B = rho0 c^2 / gamma, or rho0 c^2 for the linear EOS [Pa]
+  float support = 0;              // kernel support radius H [m]
+  float smoothing = 0;            // h = H / 2 (CFL and viscosity length) [m]
+  float rest_density = 0;         // rho0 of the fluid [kg/m^3]
+  float sound_speed = 0;          // c [m/s]
+  float stiffness = 0;            // Tait B = rho0 c^2 / gamma, or rho0 c^2 for the linear EOS [Pa]
   float kinematic_viscosity = 0;  // physical nu [m^2/s]
-  float max_speed = 0;       // blow-up threshold [m/s]
+  float max_speed = 0;            // blow-up threshold [m/s]
   // Viscosity coefficients of the forces pass: 2(d+2) nu + alpha c h between fluid particles (Monaghan
   // 2005 eq. 4.8 and its artificial-viscosity equivalent), alpha_b c h against boundary particles.
   float visc_fluid = 0, visc_boundary = 0;
@@ -114,7 +116,7 @@ class Solver {
     float cell = 0;
     int nx = 0, ny = 0, nz = 0;
     Eigen::Vector3f cells = Eigen::Vector3f::Zero();  // cell size per axis: `cell`, or a periodic axis's
-    int reach = 1;  // cells visited on each side
+    int reach = 1;                                    // cells visited on each side
   };
   const GridInfo& grid() const { return grid_; }
   std::vector<std::uint32_t> cell_starts() const;
@@ -172,8 +174,8 @@ class Solver {
   bool grid_built_ = false;
   std::vector<thermal::MaterialThermal> table_;
   EnergyBudget budget_;
-  cl::Buffer enthalpy_, spare_enthalpy_, materials_, thermal_, lamp_energy_, hits_, budget_parts_, budget_tiles_,
-      budget_bad_, dryers_;
+  cl::Buffer enthalpy_, spare_enthalpy_, materials_, thermal_, lamp_energy_, hits_, budget_parts_,
+      budget_tiles_, budget_bad_, dryers_;
   bool dryers_dirty_ = true;
   std::unique_ptr<PhotonTracer> photons_;
   cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_heat_budget_;

@@ -72,7 +72,8 @@ double tilt_degrees(const RigidBody& b, const Eigen::Vector3d& height_axis) {
 double righting_arm(double b, double h, double f, double theta) {
   const double c = std::cos(theta), s = std::sin(theta);
   std::vector<Eigen::Vector2d> corners;
-  for (const auto& [x, z] : {std::pair{-0.5 * b, -0.5 * h}, {0.5 * b, -0.5 * h}, {0.5 * b, 0.5 * h}, {-0.5 * b, 0.5 * h}})
+  for (const auto& [x, z] :
+       {std::pair{-0.5 * b, -0.5 * h}, {0.5 * b, -0.5 * h}, {0.5 * b, 0.5 * h}, {-0.5 * b, 0.5 * h}})
     corners.emplace_back(x * c + z * s, -x * s + z * c);
   // The part of the polygon below z = w (Sutherland-Hodgman against one half-plane): its area and centroid.
   auto below = [&](double w, double& cx) {

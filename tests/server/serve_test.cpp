@@ -16,7 +16,8 @@ using testing::TempDir;
 
 TEST(ServeSmoke, FramesDryerMeltsIceStateAndCleanShutdown) {
   TempDir dir("serve-smoke");
-  ServedScene served(dir, "default --state-dir states --state-out final.state");
+  // Heat 4x faster than the scene's own, so the ice visibly melts within seconds of streaming.
+  ServedScene served(dir, "default --set heat.time_scale=400 --state-dir states --state-out final.state");
   ASSERT_GT(served.port(), 0) << served.log();
   int client_status = 0;
   const std::string out = served.run_python(R"(import asyncio, json, thaw_client
@@ -109,7 +110,8 @@ async def main():
         print("after acks", ack["type"])
         replies = [thaw.send({"type": "view.set", "view": "surface"}) for _ in range(int(2 * burst))]
         kinds = [r.get("code", r["type"]) for r in await asyncio.gather(*replies)]
-        print("flood", kinds.count("ack") >= burst - 1, kinds.count("rate_limited") > 0)
+        # hello and the view.set above took two tokens of the full bucket
+        print("flood", kinds.count("ack") >= burst - 2, kinds.count("rate_limited") > 0)
         await asyncio.sleep(1.5)
         print("later", (await thaw.command("view.set", view="surface"))["type"])
 asyncio.run(main())

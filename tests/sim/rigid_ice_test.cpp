@@ -110,7 +110,9 @@ Json dumbbell_scene() {
           {"materials", materials()},
           {"ice",
            {{{"material", "ice"}, {"box", cube(0)}, {"motion", "free"}, {"temperature", 0.0}},
-            {{"material", "ice"}, {"box", box(4 * dx, dx, dx, 6 * dx, 2 * dx, 2 * dx)}, {"motion", "free"},
+            {{"material", "ice"},
+             {"box", box(4 * dx, dx, dx, 6 * dx, 2 * dx, 2 * dx)},
+             {"motion", "free"},
              {"temperature", 0.0}},
             {{"material", "ice"}, {"box", cube(6 * dx)}, {"motion", "free"}, {"temperature", 0.0}}}}};
 }
@@ -150,13 +152,16 @@ TEST_F(RigidIceTest, AMeltedNeckCutsADumbbellIntoTwoBodies) {
 // the wall particles, without passing into them.
 TEST_F(RigidIceTest, IceRestsOnTheFloorWithoutPassingThrough) {
   const double dx = 0.004;
-  Json doc = {{"name", "drop"},
-              {"domain", {{"min", {0, 0, 0}}, {"max", {0.04, 0.04, 0.06}}, {"walls", {"-z"}}, {"wall_material", "wall"}}},
-              {"spacing", dx},
-              {"heat", {{"enabled", false}}},
-              {"materials", materials()},
-              {"fluids", Json::array()},
-              {"ice", {{{"material", "ice"}, {"box", box(0.012, 0.012, 0.02, 0.028, 0.028, 0.036)}, {"motion", "free"}}}}};
+  Json doc = {
+      {"name", "drop"},
+      {"domain",
+       {{"min", {0, 0, 0}}, {"max", {0.04, 0.04, 0.06}}, {"walls", {"-z"}}, {"wall_material", "wall"}}},
+      {"spacing", dx},
+      {"heat", {{"enabled", false}}},
+      {"materials", materials()},
+      {"fluids", Json::array()},
+      {"ice",
+       {{{"material", "ice"}, {"box", box(0.012, 0.012, 0.02, 0.028, 0.028, 0.036)}, {"motion", "free"}}}}};
   // No fluid to set the speed of sound: give the contact springs one.
   doc["solver"] = {{"speed_of_sound", 10.0}};
   const Scene scene = scene_from_json(doc);

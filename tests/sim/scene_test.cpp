@@ -487,7 +487,7 @@ TEST(SceneShapes, LaterIceAndFluidsSkipWhatIsAlreadyFilled) {
 }
 
 TEST(SceneShapes, ExistingIceBlocksKeepTheirMeaning) {
-  const Scene s = load_scene("default");
+  const Scene s = load_scene("glass-ice-cubes");  // ice entries written before shapes and motion existed
   const Json& ice = s.source["ice"];
   ASSERT_EQ(s.ice.size(), ice.size());
   for (std::size_t i = 0; i < s.ice.size(); ++i) {
