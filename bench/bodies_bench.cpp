@@ -222,26 +222,6 @@ void reference_sums(const HostParticles& p, const std::vector<Float4>& force,
   }
 }
 
-Terms flatten(const BodySums& s) {
-  const auto& S = s.second_moment;
-  return {s.mass,
-          s.first_moment.x(),
-          s.first_moment.y(),
-          s.first_moment.z(),
-          S(0, 0),
-          S(1, 1),
-          S(2, 2),
-          S(0, 1),
-          S(0, 2),
-          S(1, 2),
-          s.force.x(),
-          s.force.y(),
-          s.force.z(),
-          s.torque.x(),
-          s.torque.y(),
-          s.torque.z()};
-}
-
 template <class F>
 double best_of(int reps, const std::function<void()>& pause, F&& f) {
   double best = std::numeric_limits<double>::infinity();
@@ -396,7 +376,7 @@ Json bench_bodies(ClRuntime& cl, const BodiesBenchOptions& o, bool print) {
   double worst = 0;
   bool counts_match = true;
   for (std::uint32_t b = 0; b < nbodies; ++b) {
-    const Terms got = flatten(sums[b]);
+    const Terms got = sums[b].terms();
     for (std::size_t k = 0; k < got.size(); ++k) {
       const double err = std::abs(got[k] - ref_sums[b][k]);
       worst = std::max(worst, scale[b][k] > 0 ? err / scale[b][k] : err);

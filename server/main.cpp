@@ -24,6 +24,8 @@ const char* kUsage =
     "  bench throughput µs per particle-step per stage, with a hand-written reference loop (--json)\n"
     "  bench accuracy CASE  error against run time over resolutions (--res 10,15,20 --out DIR)\n"
     "  bench render     ms per frame by stage (field, upload, march, read-back, JPEG) (--sizes, --json)\n"
+    "  bench bodies     ice labelling and per-body sums against union-find and a plain loop (--size, "
+    "--json)\n"
     "  render STATE     one frame of a state file: --out FILE.png, --view surface|particles|slice,\n"
     "                   --size WxH, --camera AZ,EL[,DIST], --target X,Y,Z, --fov DEG, --colour-by\n"
     "                   phase|temperature, --slice AXIS[,FRACTION], --field-cells N, --quality full|fast,\n"
@@ -37,7 +39,8 @@ const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "help")) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+      !std::strcmp(argv[1], "help")) {
     std::fputs(kUsage, argc < 2 ? stderr : stdout);
     return argc < 2 ? 2 : 0;
   }

@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "sim/cl_launch.h"
 #include "sim/error.h"
 #include "sim/particles.h"
 
@@ -12,9 +13,6 @@ namespace thaw {
 namespace {
 
 static_assert(static_cast<int>(Phase::Ice) == 1, "THAW_PHASE_ICE in sim/kernels/grid_common.h");
-
-// Work-group size of the one-work-item-per-particle kernels, as in sim/solver.cpp.
-constexpr std::size_t kGroup = 64;
 
 // SIMD lanes of the neighbour walk (THAW_VW): 8, as the solver's neighbour passes.
 constexpr int kLanes = 8;
@@ -32,18 +30,6 @@ constexpr std::uint32_t kChunk = 256;
 
 // Sum terms per particle (body_terms in body_sums.cl): m, m r (3), m r r^T (6), f (3), r x f (3).
 constexpr std::size_t kTerms = 16;
-
-template <class... Args>
-void set_args(cl::Kernel& k, const Args&... args) {
-  cl_uint i = 0;
-  (k.setArg(i++, args), ...);
-}
-
-// n work-items in groups of kGroup; the kernels ignore ids >= n.
-void launch(cl::CommandQueue& q, cl::Kernel& k, std::size_t n) {
-  const std::size_t global = (std::max<std::size_t>(n, 1) + kGroup - 1) / kGroup * kGroup;
-  q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(kGroup));
-}
 
 // One work-item per tile (or per body): few and long, so pocl picks the group size.
 void launch_few(cl::CommandQueue& q, cl::Kernel& k, std::size_t n) {

@@ -3,6 +3,7 @@
 // (connected-component labelling, Fig. 4), and the per-body sums the rigid-body stage needs (mass, first
 // and second moments, force, torque). Kernels: sim/kernels/ice_labels.cl, sim/kernels/body_sums.cl.
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -103,6 +104,15 @@ struct BodySums {
   Eigen::Matrix3d second_moment = Eigen::Matrix3d::Zero();  // sum m r r^T [kg m^2], symmetric
   Eigen::Vector3d force = Eigen::Vector3d::Zero();          // sum f [N]
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();         // sum r x f [N m]
+
+  // The 16 sums in one array, in the kernel's order: m, m r (3), m r r^T (xx, yy, zz, xy, xz, yz), f (3),
+  // r x f (3) (for comparing against reference loops).
+  std::array<double, 16> terms() const {
+    const Eigen::Matrix3d& S = second_moment;
+    return {mass,      first_moment.x(), first_moment.y(), first_moment.z(), S(0, 0),   S(1, 1),
+            S(2, 2),   S(0, 1),          S(0, 2),          S(1, 2),          force.x(), force.y(),
+            force.z(), torque.x(),       torque.y(),       torque.z()};
+  }
 
   // Inertia tensor about ref: sum m (|r|^2 1 - r r^T) [kg m^2].
   Eigen::Matrix3d inertia() const {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "sim/cl_launch.h"
 #include "sim/error.h"
 #include "sim/particles.h"
 
@@ -23,21 +24,6 @@ static_assert(sizeof(ClVoxelGrid) == 32, "VoxelGrid in sim/kernels/photons.cl is
 
 // Stefan-Boltzmann constant [W m^-2 K^-4] (CODATA 2018, exact).
 constexpr double kStefanBoltzmann = 5.670374419e-8;
-
-// Work-group size, as in sim/solver.cpp (pocl's own choice divides the global size badly).
-constexpr std::size_t kGroup = 64;
-
-template <class... Args>
-void set_args(cl::Kernel& k, const Args&... args) {
-  cl_uint i = 0;
-  (k.setArg(i++, args), ...);
-}
-
-// n work-items in groups of kGroup; the kernels ignore ids >= n.
-void launch(cl::CommandQueue& q, cl::Kernel& k, std::size_t n) {
-  const std::size_t global = (std::max<std::size_t>(n, 1) + kGroup - 1) / kGroup * kGroup;
-  q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(kGroup));
-}
 
 cl_float4 f4(const Eigen::Vector3f& v) { return {{v.x(), v.y(), v.z(), 0.0f}}; }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <map>
 
+#include "sim/cl_launch.h"
 #include "sim/error.h"
 
 namespace thaw {
@@ -25,17 +26,6 @@ struct ClContact {
 
 cl_float4 f4(const Eigen::Vector3d& v, float w = 0.f) {
   return {{float(v.x()), float(v.y()), float(v.z()), w}};
-}
-
-template <class... Args>
-void set_args(cl::Kernel& k, const Args&... args) {
-  cl_uint i = 0;
-  (k.setArg(i++, args), ...);
-}
-
-void launch(cl::CommandQueue& q, cl::Kernel& k, std::size_t n) {
-  if (n == 0) return;
-  q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n));
 }
 
 // Two ice particles belong to one body when closer than this many spacings: lattice face (1) and edge

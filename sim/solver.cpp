@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "sim/cl_grid.h"
+#include "sim/cl_launch.h"
 #include "sim/error.h"
 #include "sim/kernels/dryer_model.h"
 #include "sim/photons.h"
@@ -27,10 +28,6 @@ constexpr int kGridReach = 1;
 // width) beat 4 and 16 on the AVX-512 machine of docs/BENCHMARKS.md.
 constexpr int kLanes = 8;
 
-// Work-group size of the one-work-item-per-particle kernels. Left to itself pocl picks a divisor of
-// the global size (15 for 135645 particles), which made the simple kernels a third slower.
-constexpr std::size_t kGroup = 64;
-
 const std::vector<std::string> kPrelude = {"sph_kernel.h", "grid_common.h", "sph_lanes.h"};
 
 std::vector<std::string> with_prelude(std::initializer_list<std::string> files) {
@@ -39,20 +36,7 @@ std::vector<std::string> with_prelude(std::initializer_list<std::string> files) 
   return all;
 }
 
-// Sets a kernel's arguments in order: buffers, scalars and argument structs alike.
-template <class... Args>
-void set_args(cl::Kernel& k, const Args&... args) {
-  cl_uint i = 0;
-  (k.setArg(i++, args), ...);
-}
-
 cl::NDRange global_for(std::size_t n) { return cl::NDRange(std::max<std::size_t>(n, 1)); }
-
-// One work-item per particle (n of them), in groups of kGroup; the kernels ignore ids >= n.
-void launch(cl::CommandQueue& q, cl::Kernel& k, std::size_t n) {
-  const std::size_t global = (std::max<std::size_t>(n, 1) + kGroup - 1) / kGroup * kGroup;
-  q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(kGroup));
-}
 
 ClGrid cl_grid(const Solver::GridInfo& gi) {
   return {{{gi.origin.x(), gi.origin.y(), gi.origin.z(), 0.f}},

@@ -554,26 +554,6 @@ HostSums host_sums(const SumCase& s) {
   return h;
 }
 
-std::array<double, 16> flatten(const BodySums& s) {
-  const auto& S = s.second_moment;
-  return {s.mass,
-          s.first_moment.x(),
-          s.first_moment.y(),
-          s.first_moment.z(),
-          S(0, 0),
-          S(1, 1),
-          S(2, 2),
-          S(0, 1),
-          S(0, 2),
-          S(1, 2),
-          s.force.x(),
-          s.force.y(),
-          s.force.z(),
-          s.torque.x(),
-          s.torque.y(),
-          s.torque.z()};
-}
-
 std::vector<BodySums> device_sums(ClRuntime& cl, const SumCase& s) {
   BodyReducer reducer(cl, s.mass_scale);
   BodyParticles p;
@@ -593,7 +573,7 @@ double check_sums(const SumCase& s, const std::vector<BodySums>& got) {
   double worst = 0;
   for (std::uint32_t b = 0; b < s.nbodies && b < got.size(); ++b) {
     EXPECT_EQ(got[b].count, h.count[b]) << "body " << b;
-    const auto v = flatten(got[b]);
+    const auto v = got[b].terms();
     for (int k = 0; k < 16; ++k) {
       const double err = std::abs(v[k] - h.value[b][k]);
       const double rel = h.scale[b][k] > 0 ? err / h.scale[b][k] : err;
@@ -608,7 +588,7 @@ double check_sums(const SumCase& s, const std::vector<BodySums>& got) {
 bool bitwise_equal(const std::vector<BodySums>& a, const std::vector<BodySums>& b) {
   if (a.size() != b.size()) return false;
   for (std::size_t k = 0; k < a.size(); ++k) {
-    const auto x = flatten(a[k]), y = flatten(b[k]);
+    const auto x = a[k].terms(), y = b[k].terms();
     if (a[k].count != b[k].count || std::memcmp(x.data(), y.data(), sizeof x) != 0) return false;
   }
   return true;
