@@ -261,8 +261,9 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
 ValidationCase floating_case() {
   return {
       "floating",
-      "an ice prism floats: draft / height vs rho_ice / rho_water; upright if b/H > sqrt(6f(1-f)), else it "
-      "capsizes",
+      "an ice prism floats: the heel it comes to rest at (upright if b/H > sqrt(6f(1-f)), else on its side, "
+      "from the exact righting arm) and, upright, draft / height vs rho_ice / rho_water; res = particles "
+      "across H",
       10, params, run};
 }
 
