@@ -477,13 +477,15 @@ constexpr std::pair<const char*, const char*> kShapeMeaning[] = {
 };
 
 constexpr const char* kShapes = R"(
-`rotation` is in degrees about x, then y, then z, and defaults to none. A shape is filled with the lattice
-points `min + (i + 1/2) spacing` of its bounding box that lie inside it; an axis-aligned box keeps its
-whole cells, as blocks always have. Inside a mesh is where its generalized winding number exceeds 1/2
+`rotation` is in degrees about x, then y, then z, and defaults to none. An axis-aligned box is filled
+with the lattice points `min + (i + 1/2) spacing` of its own corner and keeps its whole cells, as blocks
+always have; every other shape takes the points `domain.min + (i + 1/2) spacing` that lie inside it, so
+it meets water sampled on that lattice a spacing apart. Inside a mesh is where its generalized winding number exceeds 1/2
 (Jacobson et al. 2013), so a mesh with small holes still fills. Ice leaves out lattice points inside
 solids and earlier ice; fluids leave out points inside solids and ice; solids are sampled only as deep as
-the kernel reaches. Ice is `fixed` (held where it starts; its particles are anchored) or `free` (a rigid
-body of its own). Shipped meshes live in `configs/meshes/`.
+the kernel reaches. Ice is `fixed` (held where it starts; its particles are anchored) or `free`: each
+connected piece of ice is a rigid body that the water and contacts move, fixed when any of its
+particles is anchored; a piece that melting cuts loose becomes a body of its own. Shipped meshes live in `configs/meshes/`.
 
 ## Example
 
