@@ -20,6 +20,7 @@
 #include "sim/cl_grid.h"
 #include "sim/error.h"
 #include "sim/ice_bodies.h"
+#include "sim/kernels/sph_kernel.h"
 #include "sim/solver.h"
 
 namespace thaw {
@@ -42,7 +43,9 @@ HostParticles bench_lattice(int side, double dx, std::uint8_t water, std::uint8_
         const bool is_ice = in_block && x != mid && y != mid;
         const float mass = static_cast<float>(1000.0 * dx * dx * dx);
         p.position[i] = {float((x + 0.5) * dx), float((y + 0.5) * dx), float((z + 0.5) * dx), mass};
-        p.velocity[i] = {0.f, 0.f, 0.f, 0.f};
+        // Some motion, so the ice-force pass's viscosity term has something to work on.
+        p.velocity[i] = {0.01f * std::sin(0.7f * float(i)), 0.01f * std::cos(1.3f * float(i)),
+                         0.01f * std::sin(2.1f * float(i)), 0.f};
         p.density[i] = 1000.0f;
         p.phase[i] = is_ice ? kIce : static_cast<std::uint8_t>(Phase::Water);
         p.material[i] = is_ice ? ice : water;
@@ -68,6 +71,13 @@ Scene bench_scene(int side, double dx) {
           {"specific_heat", 2050},
           {"melts_into", "water"}}}}},
       {"fluids", {{{"material", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", {L, L, L}}}}}}},
+      // Free ice, so the solver builds its rigid-ice stage (the particles come from bench_lattice), with
+      // a viscous coupling to time both of the ice-force pass's terms.
+      {"ice",
+       {{{"material", "ice"},
+         {"box", {{"min", {L / 8, L / 8, L / 8}}, {"max", {L - L / 8, L - L / 8, L - L / 8}}}},
+         {"motion", "free"}}}},
+      {"solver", {{"boundary_viscosity", 0.1}}},
   };
   return scene_from_json(doc);
 }
@@ -219,6 +229,49 @@ void reference_sums(const HostParticles& p, const std::vector<Float4>& force,
       for (std::size_t k = 0; k < v.size(); ++k) s[k] += v[k];
     }
     ++counts[b];
+  }
+}
+
+// The reference ice-force pass (sim/kernels/rigid.cl, rigid_forces) over the same sorted particles and
+// grid walk: for each ice particle, the reaction to the water's pressure and viscosity forces from it as
+// a boundary particle. Contacts are left out: the bench's bodies are a water layer apart.
+void reference_ice_forces(const HostParticles& p, const std::vector<Float4>& state,
+                          const std::vector<std::uint32_t>& cell_start, const Solver::GridInfo& g, float H,
+                          float eps2, float visc_boundary, std::vector<Float4>& out) {
+  const auto n = static_cast<std::uint32_t>(p.size());
+  const float inv[3] = {1.0f / g.cells.x(), 1.0f / g.cells.y(), 1.0f / g.cells.z()};
+  const int dims[3] = {g.nx, g.ny, g.nz};
+  const int reach = g.reach;
+  const float H2 = H * H;
+  out.assign(n, Float4{0.f, 0.f, 0.f, 0.f});
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (p.phase[i] != kIce) continue;
+    const Float4 xi = p.position[i], vi = p.velocity[i];
+    const float rho_i = state[i][0], dpi = state[i][1];
+    int c[3];
+    for (int a = 0; a < 3; ++a)
+      c[a] = std::clamp(static_cast<int>(std::floor((xi[a] - g.origin[a]) * inv[a])), 0, dims[a] - 1);
+    float f[3] = {0.f, 0.f, 0.f};
+    for (int z = std::max(c[2] - reach, 0); z <= std::min(c[2] + reach, g.nz - 1); ++z)
+      for (int y = std::max(c[1] - reach, 0); y <= std::min(c[1] + reach, g.ny - 1); ++y) {
+        const int row = (z * g.ny + y) * g.nx;
+        const std::uint32_t jb = cell_start[row + std::max(c[0] - reach, 0)];
+        const std::uint32_t je = cell_start[row + std::min(c[0] + reach, g.nx - 1) + 1];
+        for (std::uint32_t j = jb; j < je; ++j) {
+          if (p.phase[j] != static_cast<std::uint8_t>(Phase::Water)) continue;
+          const float d[3] = {xi[0] - p.position[j][0], xi[1] - p.position[j][1], xi[2] - p.position[j][2]};
+          const float r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+          if (r2 >= H2) continue;
+          const float mj = p.position[j][3];
+          const float vd = (vi[0] - p.velocity[j][0]) * d[0] + (vi[1] - p.velocity[j][1]) * d[1] +
+                           (vi[2] - p.velocity[j][2]) * d[2];
+          const float s = visc_boundary * mj / rho_i * vd / (r2 + eps2) - mj * (dpi + state[j][1]);
+          const float gf = s * sph::cubic_spline_grad_factor(std::sqrt(r2), H);
+          for (int a = 0; a < 3; ++a) f[a] += gf * d[a];
+        }
+      }
+    out[i] = {xi[3] * f[0], xi[3] * f[1], xi[3] * f[2], 0.f};
   }
 }
 
@@ -384,6 +437,33 @@ Json bench_bodies(ClRuntime& cl, const BodiesBenchOptions& o, bool print) {
   }
   for (std::uint32_t b = 0; b < nbodies; ++b) counts_match = counts_match && sums[b].count == ref_counts[b];
 
+  // Coupling: the ice-force pass against the reference loop, on the density pass's pressure state.
+  solver.compute_density();
+  solver.label_ice();
+  const std::vector<Float4> pstate = solver.pressure_state();
+  const SolverConstants& sc = solver.constants();
+  const float eps2 = 0.01f * sc.smoothing * sc.smoothing;
+  std::vector<Float4> ref_force;
+  double force_s = std::numeric_limits<double>::infinity(), ref_force_s = force_s;
+  for (int r = 0; r < o.reps; ++r) {
+    force_s = std::min(force_s, best_of(1, pause, [&] {
+                         solver.compute_ice_forces();
+                         cl.queue().finish();
+                       }));
+    ref_force_s = std::min(ref_force_s, best_of(1, pause, [&] {
+                             reference_ice_forces(p, pstate, cell_start, gi, sc.support, eps2,
+                                                  sc.visc_boundary, ref_force);
+                           }));
+  }
+  const std::vector<Float4> dev_force = solver.ice_forces();
+  double force_scale = 0, force_err = 0;
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) {
+      force_scale = std::max(force_scale, double(std::abs(ref_force[i][a])));
+      force_err = std::max(force_err, double(std::abs(dev_force[i][a] - ref_force[i][a])));
+    }
+  const double force_rel = force_scale > 0 ? force_err / force_scale : force_err;
+
   Json out;
   out["device"] = cl.description();
   out["omp_threads"] = omp_get_max_threads();
@@ -399,6 +479,9 @@ Json bench_bodies(ClRuntime& cl, const BodiesBenchOptions& o, bool print) {
   out["reference_sums_us"] = ref_sums_s * per;
   out["sums_counts_match_reference"] = counts_match;
   out["sums_max_err_of_sum_of_magnitudes"] = worst;
+  out["ice_forces_us"] = force_s * per;
+  out["reference_ice_forces_us"] = ref_force_s * per;
+  out["ice_forces_max_err_of_largest"] = force_rel;
   if (print) {
     std::printf("%u particles (%zu ice in %u bodies), connection radius %.2f spacings, grid reach %d; %s\n",
                 n, ice_count, nbodies, o.radius, gi.reach, cl.description().c_str());
@@ -419,6 +502,9 @@ Json bench_bodies(ClRuntime& cl, const BodiesBenchOptions& o, bool print) {
     std::printf("%-28s %10.4f\n", "body sums, device", sums_s * per);
     std::printf("%-28s %10.4f   (max error / sum of |terms| %.2e, counts %s)\n", "body sums, reference loop",
                 ref_sums_s * per, worst, counts_match ? "match" : "DIFFER");
+    std::printf("%-28s %10.4f\n", "ice forces, device", force_s * per);
+    std::printf("%-28s %10.4f   (max error / largest force %.2e)\n", "ice forces, reference loop",
+                ref_force_s * per, force_rel);
     std::printf(
         "(labelling: IceLabeller::label, one walk for the neighbour lists, then sweeps with a flag read back "
         "after each;\n ids shuffled: a random permutation, as water that froze after mixing; reference: "

@@ -248,6 +248,12 @@ void RigidIce::advance(const ParticleBuffers& p, double dt) {
   launch(cl_.queue(), k_place_, p.n);
 }
 
+std::vector<Float4> RigidIce::forces(std::size_t n) const {
+  std::vector<Float4> out(n);
+  if (n) cl_.queue().enqueueReadBuffer(force_, CL_TRUE, 0, n * 16, out.data());
+  return out;
+}
+
 RigidIce::Saved RigidIce::save(std::size_t n) const {
   Saved s;
   s.body.resize(n);

@@ -89,6 +89,8 @@ class RigidIce {
   void note_phase_change() { phase_changed_ = true; }
 
   const std::vector<IceBody>& bodies() const { return bodies_; }
+  // The force on each particle from the last compute_forces() [N] (benchmarks and tests).
+  std::vector<Float4> forces(std::size_t n) const;
   std::uint64_t labellings() const { return labellings_; }
   int last_iterations() const { return last_iterations_; }
 

@@ -687,6 +687,18 @@ void Solver::compute_heat(double dt) {
   }
 }
 
+void Solver::label_ice() {
+  if (rigid_) rigid_->relabel_if_due(buffers(), steps_, true);
+}
+
+void Solver::compute_ice_forces() {
+  if (rigid_) rigid_->compute_forces(buffers());
+}
+
+std::vector<Float4> Solver::ice_forces() const {
+  return rigid_ ? rigid_->forces(n_) : std::vector<Float4>(n_, Float4{0.f, 0.f, 0.f, 0.f});
+}
+
 void Solver::integrate(double dt) {
   if (n_ == 0) return;
   set_args(k_integrate_, position_, velocity_, accel_, phase_, static_cast<float>(dt),

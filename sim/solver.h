@@ -106,6 +106,11 @@ class Solver {
   void trace_photons(double dt);  // lamps: photons absorbed this step, as energy per particle
   void compute_heat(double dt);   // conduction, sources, enthalpy update, phase change, budget
   void integrate(double dt);
+  // Rigid ice only (no-ops otherwise): label the ice into bodies now, and the ice-force pass; the force
+  // on each particle [N] as that pass left it (zero for all but ice of free bodies).
+  void label_ice();
+  void compute_ice_forces();
+  std::vector<Float4> ice_forces() const;
 
   // Rigid ice (scenes with free ice; null otherwise): the bodies, labelling and its counters.
   const RigidIce* rigid_ice() const { return rigid_.get(); }

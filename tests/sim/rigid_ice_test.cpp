@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "bench/bodies_bench.h"
 #include "sim/error.h"
 #include "sim/metrics.h"
 #include "sim/solver.h"
@@ -205,6 +206,21 @@ TEST_F(RigidIceTest, ResumingFromAStateFileIsBitwiseIdentical) {
   EXPECT_EQ(sa.rigid_offset, sb.rigid_offset);
   EXPECT_EQ(sa.rigid_bodies, sb.rigid_bodies);
   EXPECT_FALSE(sa.rigid_bodies.empty());
+}
+
+// `thaw bench bodies` at a small size: the device's labels, body sums and ice forces agree with its
+// hand-written reference loops (the benchmark's timings are not asserted).
+TEST_F(RigidIceTest, BenchBodiesAgreesWithItsReferenceLoops) {
+  BodiesBenchOptions o;
+  o.particles = 8000;
+  o.reps = 1;
+  const Json r = bench_bodies(cl(), o, false);
+  EXPECT_TRUE(r["labelling"][0]["labels_match_reference"].get<bool>());
+  EXPECT_TRUE(r["labelling"][1]["labels_match_reference"].get<bool>());
+  EXPECT_TRUE(r["sums_counts_match_reference"].get<bool>());
+  EXPECT_LT(r["sums_max_err_of_sum_of_magnitudes"].get<double>(), 1e-6);
+  EXPECT_LT(r["ice_forces_max_err_of_largest"].get<double>(), 1e-5);
+  EXPECT_GT(r["ice_particles"].get<std::size_t>(), 0u);
 }
 
 }  // namespace
