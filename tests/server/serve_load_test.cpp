@@ -4,7 +4,6 @@
 // stays flat).
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <string>
 
 #include "tests/server/serve_support.h"
@@ -15,14 +14,6 @@ namespace {
 using testing::ServedScene;
 using testing::TempDir;
 
-// Resident memory of a process [kB], from /proc.
-long rss_kb(const std::string& pid) {
-  std::ifstream in("/proc/" + pid + "/status");
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  return -1;
-}
-
 TEST(ServeLoad, FuzzFromSeveralClientsLeavesTheServerUpAndCorrect) {
   TempDir dir("serve-fuzz");
   ServedScene served(dir, "ice-on-plate --set spacing=0.006 --state-dir states");
@@ -30,10 +21,12 @@ TEST(ServeLoad, FuzzFromSeveralClientsLeavesTheServerUpAndCorrect) {
   int status = 0;
   const std::string out = served.run_python(R"(
 import asyncio, os, sys
-sys.path.insert(0, os.path.join(")" + std::string(THAW_SOURCE_DIR) + R"(", "tests", "server"))
+sys.path.insert(0, os.path.join(")" + std::string(THAW_SOURCE_DIR) +
+                                                R"(", "tests", "server"))
 import service_clients
 asyncio.run(service_clients.fuzz(PORT))
-)", 240, &status);
+)",
+                                            240, &status);
   EXPECT_EQ(status, 0) << out;
   EXPECT_NE(out.find("replies True"), std::string::npos) << out;
   EXPECT_NE(out.find("still stepping True"), std::string::npos) << out;
@@ -63,19 +56,30 @@ async def slow(seconds):
     await ws.send('{"type": "hello", "version": 1}')
     await asyncio.sleep(seconds + 2)
     ws.transport.abort()
+def rss_kb():
+    with open("/proc/SERVER_PID/status") as f:
+        return next(int(l.split()[1]) for l in f if l.startswith("VmRSS:"))
 async def main():
     alone = await viewer(5)
+    # Memory once the server has streamed (the renderer draws only while someone watches), and after
+    # the crowd.
+    print("rss before %d" % rss_kb())
     rates = await asyncio.gather(slow(12), *[viewer(12) for _ in range(10)])
+    print("rss after %d" % rss_kb())
     print("alone %.2f" % alone)
     print("with slow", " ".join("%.2f" % r for r in rates[1:]))
     print("min ratio %.2f" % (min(rates[1:]) / alone))
 asyncio.run(main())
 )";
-  // Memory before and after the crowd.
-  const long before = rss_kb(pid);
-  const std::string out = served.run_python(script, 120, &status);
-  const long after = rss_kb(pid);
+  std::string code = script;
+  code.replace(code.find("SERVER_PID"), std::string("SERVER_PID").size(), pid);
+  const std::string out = served.run_python(code, 120, &status);
   EXPECT_EQ(status, 0) << out;
+  auto number_after = [&](const std::string& key) {
+    const auto k = out.find(key);
+    return k == std::string::npos ? -1L : std::stol(out.substr(k + key.size()));
+  };
+  const long before = number_after("rss before "), after = number_after("rss after ");
   std::printf("%s[ info ] server RSS %ld kB before, %ld kB after\n", out.c_str(), before, after);
   const auto at = out.find("min ratio ");
   ASSERT_NE(at, std::string::npos) << out;
