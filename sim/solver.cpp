@@ -46,12 +46,9 @@ ClGrid cl_grid(const Solver::GridInfo& gi) {
           gi.nz};
 }
 
-// Per material, the factor from a particle's SPH mass to its physical mass: fluids carry their
-// physical mass, static particles and ice the rest-density mass rho0 V (as in sim/thermal.cpp).
-std::vector<float> mass_scales(const Scene& scene, double rest_density) {
+std::vector<float> rigid_mass_scales(const Scene& scene, double rest_density) {
   std::vector<float> out;
-  for (const Material& m : scene.materials)
-    out.push_back(static_cast<float>(m.kind == "fluid" ? 1.0 : m.density / rest_density));
+  for (const Material& m : scene.materials) out.push_back(static_cast<float>(mass_scale(m, rest_density)));
   return out;
 }
 
@@ -361,7 +358,7 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     for (std::size_t i = 0; i < n_ && i < p.anchored.size(); ++i)
       if (p.id[i] < n_) anchored_by_id[p.id[i]] = p.anchored[i];
     rigid_ = std::make_unique<RigidIce>(cl, opts.str(), n_, rigid_settings(scene, k_),
-                                        std::move(anchored_by_id), mass_scales(scene, k_.rest_density));
+                                        std::move(anchored_by_id), rigid_mass_scales(scene, k_.rest_density));
     if (!st.rigid_body.empty()) rigid_->restore({st.rigid_body, st.rigid_offset, st.rigid_bodies}, n_);
   }
 }
@@ -655,7 +652,10 @@ void Solver::compute_heat(double dt) {
   q.enqueueNDRangeKernel(k_heat_budget_, cl::NullRange, global_for(ntiles_));
   std::vector<float> sums(std::size_t(ntiles_) * 5);
   std::vector<cl_uint> bad(ntiles_);
+  cl_uint changed = 0;
   q.enqueueReadBuffer(budget_tiles_, CL_FALSE, 0, sums.size() * 4, sums.data());
+  // Rigid ice relabels after a phase change; the flag comes back with the budget (one wait, not two).
+  if (rigid_) q.enqueueReadBuffer(phase_changed_, CL_FALSE, 0, 4, &changed);
   q.enqueueReadBuffer(budget_bad_, CL_TRUE, 0, bad.size() * 4, bad.data());
   for (std::uint32_t t = 0; t < ntiles_; ++t) {
     if (bad[t] != 0xffffffffu) {
@@ -677,13 +677,9 @@ void Solver::compute_heat(double dt) {
     budget_.walls += t5[3];
     budget_.held += t5[4];
   }
-  if (rigid_) {
-    cl_uint changed = 0;
-    q.enqueueReadBuffer(phase_changed_, CL_TRUE, 0, 4, &changed);
-    if (changed) {
-      rigid_->note_phase_change();
-      q.enqueueFillBuffer(phase_changed_, cl_uint(0), 0, 4);
-    }
+  if (changed) {
+    rigid_->note_phase_change();
+    q.enqueueFillBuffer(phase_changed_, cl_uint(0), 0, 4);
   }
 }
 

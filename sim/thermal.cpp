@@ -1,9 +1,9 @@
 #include "sim/thermal.h"
 
-#include "sim/solver.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "sim/solver.h"
 
 namespace thaw {
 
@@ -33,6 +33,10 @@ Law law_of(const Scene& scene, int material) {
 
 }  // namespace
 
+double mass_scale(const Material& m, double rest_density) {
+  return m.kind == "fluid" ? 1.0 : m.density / rest_density;
+}
+
 std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density) {
   std::vector<MaterialThermal> table;
   const double dx = scene.spacing;
@@ -52,9 +56,7 @@ std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double r
       t.k_liquid = static_cast<float>(law.ice ? other.conductivity : m.conductivity);
       t.flags |= law.ice ? THAW_MAT_MELTS : THAW_MAT_FREEZES;
     }
-    // Fluid particles carry their physical mass; static ones (solids, ice) the rest-density mass rho0 V
-    // that the fluid solver needs from a boundary particle.
-    t.thermal_mass_scale = static_cast<float>(m.kind == "fluid" ? 1.0 : m.density / rest_density);
+    t.thermal_mass_scale = static_cast<float>(mass_scale(m, rest_density));
     if (m.kind != "solid") t.flags |= THAW_MAT_AIR_EXCHANGE;
     if (m.held) {
       t.flags |= THAW_MAT_HELD;
@@ -75,14 +77,17 @@ std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double r
 double enthalpy_at(const Scene& scene, int material, double temperature) {
   const Law law = law_of(scene, material);
   // Ice is on its solid side at its melting point; everything else on its liquid side.
-  return thermal::thermal_enthalpy(temperature, law.ice ? 0 : 1, law.latent, law.melt, law.c_solid, law.c_liquid);
+  return thermal::thermal_enthalpy(temperature, law.ice ? 0 : 1, law.latent, law.melt, law.c_solid,
+                                   law.c_liquid);
 }
 
 double temperature_at(const MaterialThermal& m, double h) {
   return thermal::thermal_temperature(h, m.latent, m.melt, m.c_solid, m.c_liquid);
 }
 
-double liquid_fraction_at(const MaterialThermal& m, double h) { return thermal::thermal_liquid_fraction(h, m.latent); }
+double liquid_fraction_at(const MaterialThermal& m, double h) {
+  return thermal::thermal_liquid_fraction(h, m.latent);
+}
 
 std::vector<float> temperatures_of(const HostParticles& p, const Scene& scene) {
   std::vector<float> out;

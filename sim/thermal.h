@@ -15,6 +15,11 @@ using thermal::MaterialThermal;
 // of static particles (solids and ice carry rho0 V, their physical mass is rho V).
 std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density);
 
+// A particle's physical mass over its SPH mass, per material: fluid particles carry their physical mass;
+// static ones (solids, ice) the rest-density mass rho0 V that the fluid solver needs from a boundary
+// particle. The thermal table's and the rigid bodies' masses both come from this.
+double mass_scale(const Material& m, double rest_density);
+
 // Specific enthalpy [J/kg] of a particle of `material` at temperature T [°C] (ice below or at its melting
 // point is solid, everything else is on its liquid side).
 double enthalpy_at(const Scene& scene, int material, double temperature);
