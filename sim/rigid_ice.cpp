@@ -240,7 +240,7 @@ void RigidIce::advance(const ParticleBuffers& p, double dt) {
                                                       static_cast<std::uint32_t>(bodies_.size()));
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     RigidBody& r = bodies_[b].body;
-    if (r.fixed) continue;
+    if (r.fixed || held_) continue;
     thaw::advance(r, sums[b].force + r.mass * settings_.gravity, sums[b].torque, dt);
   }
   upload_bodies();

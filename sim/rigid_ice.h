@@ -87,6 +87,9 @@ class RigidIce {
   void advance(const ParticleBuffers& p, double dt);
   // The heat stage saw ice change phase this step.
   void note_phase_change() { phase_changed_ = true; }
+  // Held, the free bodies stay where they are (forces are still computed) until let go: a validation
+  // case settles its water around a floating body that way.
+  void hold(bool held) { held_ = held; }
 
   const std::vector<IceBody>& bodies() const { return bodies_; }
   // The force on each particle from the last compute_forces() [N] (benchmarks and tests).
@@ -118,6 +121,7 @@ class RigidIce {
   std::size_t bodies_capacity_ = 0;
   std::vector<IceBody> bodies_;
   bool phase_changed_ = false;
+  bool held_ = false;
   bool labelled_ = false;
   std::uint64_t labelled_step_ = 0;
   std::uint64_t labellings_ = 0;

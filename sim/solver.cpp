@@ -725,6 +725,10 @@ void Solver::step() {
   ++steps_;
 }
 
+void Solver::hold_ice(bool held) {
+  if (rigid_) rigid_->hold(held);
+}
+
 void Solver::warm_up() {
   // A sort of sorted keys is the identity and dt = 0 leaves x and v unchanged, so this changes no state.
   build_grid();

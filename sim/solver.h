@@ -70,6 +70,9 @@ class Solver {
 
   // Velocity relaxation rate zeta [1/s] for settling an initial state (validation cases); 0 = none.
   void set_velocity_damping(double zeta) { damping_ = zeta; }
+  // Holds every free ice body in place (RigidIce::hold) while the water settles around it; no-op
+  // without free ice.
+  void hold_ice(bool held);
 
   // Heat sources a running simulation may change (the server calls these between steps). Values are
   // checked like the scene's (Error naming the field on a bad one); index out of range is an Error.

@@ -149,10 +149,8 @@ TEST_F(RigidIceTest, AMeltedNeckCutsADumbbellIntoTwoBodies) {
   std::printf("labelling sweeps for the split: %d\n", solver.rigid_ice()->last_iterations());
 }
 
-// An ice block dropped onto the tank's floor in air comes to rest on it, a contact distance above
-// the wall particles, without passing into them.
-TEST_F(RigidIceTest, IceRestsOnTheFloorWithoutPassingThrough) {
-  const double dx = 0.004;
+// A 4 x 4 x 4 ice block in air, 2 cm above the tank's floor.
+Json drop_scene(double dx) {
   Json doc = {
       {"name", "drop"},
       {"domain",
@@ -165,7 +163,14 @@ TEST_F(RigidIceTest, IceRestsOnTheFloorWithoutPassingThrough) {
        {{{"material", "ice"}, {"box", box(0.012, 0.012, 0.02, 0.028, 0.028, 0.036)}, {"motion", "free"}}}}};
   // No fluid to set the speed of sound: give the contact springs one.
   doc["solver"] = {{"speed_of_sound", 10.0}};
-  const Scene scene = scene_from_json(doc);
+  return doc;
+}
+
+// An ice block dropped onto the tank's floor in air comes to rest on it, a contact distance above
+// the wall particles, without passing into them.
+TEST_F(RigidIceTest, IceRestsOnTheFloorWithoutPassingThrough) {
+  const double dx = 0.004;
+  const Scene scene = scene_from_json(drop_scene(dx));
   Solver solver(cl(), scene, initial_state(scene));
   solver.warm_up();
   double lowest = 1e9;
@@ -182,6 +187,27 @@ TEST_F(RigidIceTest, IceRestsOnTheFloorWithoutPassingThrough) {
   // Resting: its lowest layer a contact distance (dx) above the wall's top layer (-dx/2), so its centre,
   // 1.5 spacings above that layer, at 2 dx; the springs give way by a few micrometres under its weight.
   EXPECT_NEAR(b.position.z(), 2 * dx, 0.05 * dx);
+}
+
+// Held (as a validation case settles its water), a free block stays where it is under gravity; let go,
+// it falls from there.
+TEST_F(RigidIceTest, HeldIceStaysPutUntilLetGo) {
+  const Scene scene = scene_from_json(drop_scene(0.004));
+  Solver solver(cl(), scene, initial_state(scene));
+  solver.warm_up();
+  const Eigen::Vector3d start = solver.rigid_ice()->bodies().at(0).body.position;
+  solver.hold_ice(true);
+  while (solver.time() < 0.05) solver.step();
+  const RigidBody& held = solver.rigid_ice()->bodies().at(0).body;
+  EXPECT_EQ(held.position, start);
+  EXPECT_EQ(held.velocity.norm(), 0.0);
+  solver.hold_ice(false);
+  const double t0 = solver.time();
+  while (solver.time() < t0 + 0.05) solver.step();
+  const RigidBody& free = solver.rigid_ice()->bodies().at(0).body;
+  const double t = solver.time() - t0;
+  EXPECT_NEAR(free.velocity.z(), -9.81 * t, 1e-3);
+  EXPECT_NEAR(free.position.z(), start.z() - 0.5 * 9.81 * t * t, 1e-4);
 }
 
 // A run with rigid ice resumed from a state file continues bitwise identically.
