@@ -205,11 +205,12 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
     return rigid->bodies().front().body;
   };
   // The water levels away from the ice (see the top of the file), over the ring of columns one spacing
-  // square whose centres lie within half a margin of the walls. Columns are chosen by where they are,
+  // square within about half a margin of the walls. Columns are chosen by where they are,
   // not by where their particles are (a particle on a column's edge would leave it short), and the
   // median keeps a column whose top particle has moved next door from pulling the level down.
   const int columns = static_cast<int>(std::round(W / dx));
-  const double ring = 0.5 * margin;
+  // A whole number of spacings wide, so no particle centre ((k + 1/2) dx from a wall) lies on its edge.
+  const double ring = std::max(1.0, std::floor(0.5 * margin / dx + 1e-9)) * dx;
   const auto in_ring = [&](double x, double y) { return std::min({x, y, W - x, W - y}) < ring; };
   struct Levels {
     double surface, mass;
