@@ -100,17 +100,17 @@ TEST_F(RigidIceTest, IceAndWaterKeepTheirTotalMomentumWithoutGravity) {
 // Two ice cubes joined by a neck two particles long, in zero gravity without water, warm enough in the
 // neck to melt at once: one body before, two after the next labelling, whose masses add up to the ice
 // that is left.
-Json dumbbell_scene() {
+Json dumbbell_scene(double gravity_x = 0.0, const char* first_motion = "free") {
   const double dx = 0.004;
   auto cube = [&](double x0) { return box(x0, 0, 0, x0 + 4 * dx, 4 * dx, 4 * dx); };
   return {{"name", "dumbbell"},
           {"domain", box(-0.02, -0.02, -0.02, 0.06, 0.04, 0.04)},
-          {"gravity", {0, 0, 0}},
+          {"gravity", {gravity_x, 0, 0}},
           {"spacing", dx},
           {"ambient", {{"heat_transfer_coefficient", 0.0}}},
           {"materials", materials()},
           {"ice",
-           {{{"material", "ice"}, {"box", cube(0)}, {"motion", "free"}, {"temperature", 0.0}},
+           {{{"material", "ice"}, {"box", cube(0)}, {"motion", first_motion}, {"temperature", 0.0}},
             {{"material", "ice"},
              {"box", box(4 * dx, dx, dx, 6 * dx, 2 * dx, 2 * dx)},
              {"motion", "free"},
@@ -118,20 +118,26 @@ Json dumbbell_scene() {
             {{"material", "ice"}, {"box", cube(6 * dx)}, {"motion", "free"}, {"temperature", 0.0}}}}};
 }
 
-TEST_F(RigidIceTest, AMeltedNeckCutsADumbbellIntoTwoBodies) {
-  const Scene scene = scene_from_json(dumbbell_scene());
+// The dumbbell's initial state with its neck's two particles past the latent heat, so they melt at once.
+SimState dumbbell_with_melting_neck(const Scene& scene) {
   SimState st = initial_state(scene);
   const double dx = scene.spacing;
   std::size_t neck = 0;
   for (std::size_t i = 0; i < st.particles.size(); ++i) {
     const double x = st.particles.position[i][0];
     if (st.particles.phase[i] == std::uint8_t(Phase::Ice) && x > 4 * dx && x < 6 * dx) {
-      st.particles.enthalpy[i] = {float(1.01 * 334000.0), 0.f};  // past the latent heat: melts at once
+      st.particles.enthalpy[i] = {float(1.01 * 334000.0), 0.f};
       ++neck;
     }
   }
-  ASSERT_EQ(neck, 2u);
-  Solver solver(cl(), scene, st);
+  EXPECT_EQ(neck, 2u);
+  return st;
+}
+
+TEST_F(RigidIceTest, AMeltedNeckCutsADumbbellIntoTwoBodies) {
+  const Scene scene = scene_from_json(dumbbell_scene());
+  const double dx = scene.spacing;
+  Solver solver(cl(), scene, dumbbell_with_melting_neck(scene));
   solver.warm_up();
   ASSERT_TRUE(solver.rigid_ice());
   ASSERT_EQ(solver.rigid_ice()->bodies().size(), 1u);
@@ -147,6 +153,33 @@ TEST_F(RigidIceTest, AMeltedNeckCutsADumbbellIntoTwoBodies) {
   EXPECT_NEAR(bodies[0].body.mass, bodies[1].body.mass, 1e-12);
   EXPECT_GE(solver.rigid_ice()->labellings(), 2u);
   std::printf("labelling sweeps for the split: %d\n", solver.rigid_ice()->last_iterations());
+}
+
+// An icicle's tip: the dumbbell's first cube fixed, gravity pulling the second away from it along x.
+// Once the neck melts the tip is a free body of its own and falls freely; the root stays put.
+TEST_F(RigidIceTest, ATipCutFromAFixedRootFallsFreely) {
+  const Scene scene = scene_from_json(dumbbell_scene(9.81, "fixed"));
+  Solver solver(cl(), scene, dumbbell_with_melting_neck(scene));
+  solver.warm_up();
+  ASSERT_EQ(solver.rigid_ice()->bodies().size(), 1u);
+  EXPECT_TRUE(solver.rigid_ice()->bodies()[0].body.fixed);
+  for (int k = 0; k < 15; ++k) solver.step();
+  const auto& bodies = solver.rigid_ice()->bodies();
+  ASSERT_EQ(bodies.size(), 2u);
+  const IceBody& root = bodies[0].body.fixed ? bodies[0] : bodies[1];
+  const IceBody& tip = bodies[0].body.fixed ? bodies[1] : bodies[0];
+  ASSERT_TRUE(root.body.fixed);
+  ASSERT_FALSE(tip.body.fixed);
+  const Eigen::Vector3d root_at = root.body.position, tip_at = tip.body.position;
+  const double v0 = tip.body.velocity.x(), t0 = solver.time();
+  while (solver.time() < t0 + 0.04) solver.step();
+  const IceBody& root_now = solver.rigid_ice()->bodies()[bodies[0].body.fixed ? 0 : 1];
+  const IceBody& tip_now = solver.rigid_ice()->bodies()[bodies[0].body.fixed ? 1 : 0];
+  const double t = solver.time() - t0;
+  EXPECT_EQ(root_now.body.position, root_at);
+  EXPECT_NEAR(tip_now.body.velocity.x(), v0 + 9.81 * t, 1e-3);
+  EXPECT_NEAR(tip_now.body.position.x(), tip_at.x() + v0 * t + 0.5 * 9.81 * t * t, 1e-4);
+  EXPECT_NEAR(tip_now.body.velocity.y(), 0.0, 1e-6);
 }
 
 // A 4 x 4 x 4 ice block in air, 2 cm above the tank's floor.
