@@ -88,12 +88,6 @@ TEST(ServeCtl, SendsCommandsAndPrintsTheReplies) {
   EXPECT_NE(gone.err.find(url), std::string::npos) << gone.err;
 }
 
-}  // namespace
-}  // namespace thaw
-
-namespace thaw {
-namespace {
-
 // The token bucket stops a command flood, but not frame acknowledgements, which come with every frame.
 TEST(ServeRateLimit, FloodsAreRefusedButFrameAcksAreNotCounted) {
   TempDir dir("serve-rate");
