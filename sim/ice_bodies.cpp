@@ -92,7 +92,7 @@ std::uint32_t IceLabeller::label(const SortedIceParticles& p, const ClGrid& grid
     particles_cap_ = std::max<std::size_t>(n, particles_cap_ + particles_cap_ / 2);
     degree_ = buffer(cl_, particles_cap_ * 4);
     spare_label_ = buffer(cl_, particles_cap_ * 4);
-    points_ = buffer(cl_, points_stride(particles_cap_) * 3 * 4);
+    points_ = buffer(cl_, points_stride(particles_cap_) * 4 * 4);
     hooks_[0] = buffer(cl_, particles_cap_ * 4);
     hooks_[1] = buffer(cl_, particles_cap_ * 4);
     edges_cap_ = 0;
@@ -107,7 +107,10 @@ std::uint32_t IceLabeller::label(const SortedIceParticles& p, const ClGrid& grid
   set_args(k_slots_, p.id, slot_of_, p.id_capacity, bad_, n);
   launch(q, k_slots_, n);
   const auto stride = static_cast<cl_uint>(points_stride(n));
-  set_args(k_points_, p.position, p.phase, points_, stride, n);
+  // Without groups the kernel reads none: any buffer stands in for the argument.
+  const bool grouped = p.group() != nullptr;
+  set_args(k_points_, p.position, p.phase, grouped ? p.group : p.id, cl_uint(grouped ? 1 : 0), points_,
+           stride, n);
   launch(q, k_points_, stride);
   // The neighbour rows: walked again, wider, in the rare call where a particle has more neighbours than
   // the rows hold (the width only grows, so the next calls walk once).

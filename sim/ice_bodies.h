@@ -25,6 +25,10 @@ struct SortedIceParticles {
   cl::Buffer cell_start;  // uint [ncells + 1]: first sorted particle of each cell; the last entry is n
   std::uint32_t n = 0;
   std::uint32_t id_capacity = 0;  // every id is below this (sizes the id -> sorted index map)
+  // Optional, uint [n]: each particle's body before this labelling, or kNoBody. Two particles in different
+  // bodies are never connected, so bodies that come to touch stay apart; a particle in none (ice that
+  // froze since, or every particle at the first labelling) connects to any. Left empty: no groups.
+  cl::Buffer group;
 };
 
 struct LabelOptions {
@@ -54,14 +58,14 @@ class IceLabeller {
   // the build log) if the kernels do not build.
   IceLabeller(ClRuntime& cl, int reach);
 
-  // Connected components of the ice particles: two are connected when their distance is below radius [m],
-  // which must not exceed the grid's cell size times reach along any axis (Error otherwise; so must every
-  // id be below p.id_capacity). grid must be the one the particles were sorted with; its axes do not wrap
-  // (a periodic axis, of the heat-only mode, joins nothing across its faces). Writes label (a caller-owned
-  // uint buffer of at least p.n entries): for ice, the largest id in its component; kNoLabel for other
-  // phases. Returns the number of sweeps run, the last being the one that changed nothing. Blocks: reads
-  // a flag back after each walk and sweep. Scratch: about (row_width() + 7) * 4 bytes per particle and 4
-  // per id below id_capacity, kept for the next call.
+  // Connected components of the ice particles: two are connected when their distance is below radius [m]
+  // and their groups allow it (p.group). The radius must not exceed the grid's cell size times reach along
+  // any axis (Error otherwise; so must every id be below p.id_capacity). grid must be the one the particles
+  // were sorted with; its axes do not wrap (a periodic axis, of the heat-only mode, joins nothing across its
+  // faces). Writes label (a caller-owned uint buffer of at least p.n entries): for ice, the largest id in its
+  // component; kNoLabel for other phases. Returns the number of sweeps run, the last being the one that
+  // changed nothing. Blocks: reads a flag back after each walk and sweep. Scratch: about (row_width() + 7) *
+  // 4 bytes per particle and 4 per id below id_capacity, kept for the next call.
   std::uint32_t label(const SortedIceParticles& p, const ClGrid& grid, float radius, cl::Buffer& label,
                       const LabelOptions& options = {});
 

@@ -138,9 +138,12 @@ void RigidIce::relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool
                    (phase_changed_ && step >= labelled_step_ + std::uint64_t(settings_.relabel_interval));
   if (!due || p.n == 0) return;
   const std::size_t n = p.n;
+  // Grouped by the bodies of the last labelling: melting splits bodies, touching never joins them (ice
+  // that froze since, in no body yet, joins what it touches).
   const SortedIceParticles sorted{
       p.position,   p.phase, p.id,
-      p.cell_start, p.n,     static_cast<std::uint32_t>(std::max<std::size_t>(anchored_by_id_.size(), n))};
+      p.cell_start, p.n,     static_cast<std::uint32_t>(std::max<std::size_t>(anchored_by_id_.size(), n)),
+      body_};
   last_iterations_ = static_cast<int>(
       labeller_->label(sorted, p.grid, static_cast<float>(kConnectSpacings * settings_.spacing), label_));
   // The bodies follow from the labels on the host: this runs only when ice changed phase.

@@ -9,7 +9,9 @@
 // icicle's root, a pedestal glued to the floor); the rest are free. Labels are recomputed after the
 // neighbour sort of a step that follows a phase change of ice (melting can cut a body in two, freezing
 // can join two), at most every `relabel_interval` steps; between labellings a melted particle leaves
-// its body at once and a frozen one stays in place until the next labelling adopts it.
+// its body at once and a frozen one stays in place until the next labelling adopts it. Bodies that merely
+// touch stay apart: a labelling connects particles of one body, or a particle in none (the first
+// labelling's, newly frozen ones), never two of different bodies.
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>

@@ -24,9 +24,10 @@
 
 /* The ice particles' coordinates as x, y, z blocks of `stride` floats for the lanes of ice_neighbours; NaN
  * for other phases and the padding (up to THAW_VW - 1 past the last particle is read), so their distance
- * test fails without a phase test. */
-kernel void ice_points(global const float4* pos, global const uchar* phase, global float* points,
-                       const uint stride, const uint n) {
+ * test fails without a phase test. A fourth block holds each particle's group as an int: its body before
+ * this labelling (with use_group), or -1 (kNoBody's bits: in no body yet, or no groups given). */
+kernel void ice_points(global const float4* pos, global const uchar* phase, global const uint* group,
+                       const uint use_group, global float* points, const uint stride, const uint n) {
   const uint i = get_global_id(0);
   if (i >= stride) return;
   const bool ice = i < n && phase[i] == THAW_PHASE_ICE;
@@ -34,6 +35,7 @@ kernel void ice_points(global const float4* pos, global const uchar* phase, glob
   points[i] = p.x;
   points[stride + i] = p.y;
   points[2 * stride + i] = p.z;
+  ((global int*)points)[3 * stride + i] = (ice && use_group) ? (int)group[i] : -1;
 }
 
 int lanes_sum_int4(int4 a) { return (a.x + a.y) + (a.z + a.w); }
@@ -41,7 +43,8 @@ int lanes_sum_int8(int8 a) { return lanes_sum_int4(a.lo + a.hi); }
 int lanes_sum_int16(int16 a) { return lanes_sum_int8(a.lo + a.hi); }
 #define lanes_sum_int THAW_CAT(lanes_sum_int, THAW_VW)
 
-/* Each ice particle's ice neighbours within the radius, in the grid walk's order, in its row of `width`
+/* Each ice particle's ice neighbours within the radius and in a compatible group (the same one, or either
+ * in none: two bodies that come to touch stay two, new ice joins what it touches), in the grid walk's order, in its row of `width`
  * slots (edges[i * width + k]); degree[i] is the full count, and a count beyond the width is reported in
  * overflow[0] (the largest; the atomic runs only then) so the host can widen the rows and walk again.
  * Candidates are tested THAW_VW at a time (SIMD lanes, grid_common.h); the few hits are then written one
@@ -55,7 +58,10 @@ kernel void ice_neighbours(global const float* points, const uint stride, global
   global const float* X = points;
   global const float* Y = points + stride;
   global const float* Z = points + 2 * stride;
+  global const int* G = (global const int*)(points + 3 * stride);
   const float4 p = (float4)(X[i], Y[i], Z[i], 0.0f);
+  const int gi = G[i];
+  const intV any_group = (intV)(gi == -1 ? -1 : 0);
   const float r2 = radius * radius;
   uint count = 0;
   const bool ice = !isnan(p.x);
@@ -78,7 +84,9 @@ kernel void ice_neighbours(global const float* points, const uint stride, global
           const floatV dz = p.z - vloadV(0, Z + j);
           const floatV d2 = dx * dx + dy * dy + dz * dz;
           const intV lane = THAW_LANE_IDS;
-          const intV hit = (d2 < r2) & (lane < (int)(je - j)) & (lane != (int)(i - j));
+          const intV gj = vloadV(0, G + j);
+          const intV hit = (d2 < r2) & (lane < (int)(je - j)) & (lane != (int)(i - j)) &
+                           (any_group | (gj == (intV)(gi)) | (gj == (intV)(-1)));
           /* The hits as bits (distinct bits: the sum is their union), taken lowest first. */
           uint bits = lanes_sum_int(select((intV)(0), (intV)(1) << lane, hit));
           while (bits) {

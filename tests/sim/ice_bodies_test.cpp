@@ -56,11 +56,13 @@ struct Cloud {
   std::vector<Float4> pos;
   std::vector<std::uint8_t> phase, material;
   std::vector<std::uint32_t> id;
-  void add(const Eigen::Vector3f& x, std::uint8_t ph, float mass = 1.0f) {
+  std::vector<std::uint32_t> group;  // the body before labelling (SortedIceParticles::group), or kNoBody
+  void add(const Eigen::Vector3f& x, std::uint8_t ph, float mass = 1.0f, std::uint32_t in = kNoBody) {
     pos.push_back({x.x(), x.y(), x.z(), mass});
     phase.push_back(ph);
     material.push_back(0);
     id.push_back(static_cast<std::uint32_t>(id.size()));
+    group.push_back(in);
   }
   std::size_t size() const { return pos.size(); }
 };
@@ -93,12 +95,14 @@ Sorted sort_by_cell(const Cloud& c, const HostGrid& g) {
   s.p.phase.resize(n);
   s.p.material.resize(n);
   s.p.id.resize(n);
+  s.p.group.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t d = next[key[i]]++;
     s.p.pos[d] = c.pos[i];
     s.p.phase[d] = c.phase[i];
     s.p.material[d] = c.material[i];
     s.p.id[d] = c.id[i];
+    s.p.group[d] = c.group[i];
   }
   return s;
 }
@@ -136,8 +140,13 @@ struct UnionFind {
   void unite(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
 };
 
-// Per particle (sorted order): the largest id in its ice component, or kNoLabel. All pairs: no grid.
-std::vector<std::uint32_t> reference_labels(const Cloud& p, float radius, std::size_t* max_degree = nullptr) {
+// Whether two particles' groups let them connect: the same group, or either in none.
+bool compatible(std::uint32_t a, std::uint32_t b) { return a == b || a == kNoBody || b == kNoBody; }
+
+// Per particle (sorted order): the largest id in its ice component, or kNoLabel. All pairs: no grid. With
+// grouped, only pairs whose groups are compatible connect.
+std::vector<std::uint32_t> reference_labels(const Cloud& p, float radius, bool grouped = false,
+                                            std::size_t* max_degree = nullptr) {
   const std::size_t n = p.size();
   const float r2 = radius * radius;
   UnionFind uf(n);
@@ -145,7 +154,8 @@ std::vector<std::uint32_t> reference_labels(const Cloud& p, float radius, std::s
   for (std::size_t i = 0; i < n; ++i) {
     if (p.phase[i] != kIce) continue;
     for (std::size_t j = i + 1; j < n; ++j)
-      if (p.phase[j] == kIce && near(p.pos[i], p.pos[j], r2)) {
+      if (p.phase[j] == kIce && near(p.pos[i], p.pos[j], r2) &&
+          (!grouped || compatible(p.group[i], p.group[j]))) {
         uf.unite(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
         ++degree[i];
         ++degree[j];
@@ -168,8 +178,9 @@ std::vector<std::uint32_t> reference_labels(const Cloud& p, float radius, std::s
 struct DeviceSet {
   SortedIceParticles p;
   cl::Buffer material, label, body;
-  DeviceSet(ClRuntime& cl, const Sorted& s, std::uint32_t id_capacity) {
+  DeviceSet(ClRuntime& cl, const Sorted& s, std::uint32_t id_capacity, bool grouped = false) {
     p.position = upload(cl, s.p.pos);
+    if (grouped) p.group = upload(cl, s.p.group);
     p.phase = upload(cl, s.p.phase);
     p.id = upload(cl, s.p.id);
     p.cell_start = upload(cl, s.cell_start);
@@ -196,12 +207,12 @@ class IceBodiesTest : public ClSuite {
   // the sweeps.
   std::uint32_t check_labels(const Sorted& s, const HostGrid& g, int reach, float radius,
                              std::uint32_t capacity, const LabelOptions& o = {},
-                             std::size_t* bodies = nullptr) {
+                             std::size_t* bodies = nullptr, bool grouped = false) {
     IceLabeller labeller(cl(), reach);
-    DeviceSet d(cl(), s, capacity);
+    DeviceSet d(cl(), s, capacity, grouped);
     const IceBodies b = labeller.find_bodies(d.p, g.cl(), radius, d.label, d.body, o);
     const std::uint32_t sweeps = labeller.last_sweeps();
-    const auto expected = reference_labels(s.p, radius);
+    const auto expected = reference_labels(s.p, radius, grouped);
     const auto got = read_u32(cl(), d.label, s.p.size());
     std::size_t wrong = 0;
     for (std::size_t i = 0; i < got.size(); ++i)
@@ -278,6 +289,43 @@ TEST_F(IceBodiesTest, RandomCloudsOfMixedPhasesMatchUnionFind) {
   }
 }
 
+TEST_F(IceBodiesTest, GroupsKeepTouchingBodiesApart) {
+  // Random clouds whose particles belong to one of three earlier bodies or to none: pairs of different
+  // bodies never connect, a particle in none connects to any (the union-find applies the same rule).
+  const float r = 0.1f;
+  for (const auto& [n, side, seed] : {std::tuple{3000, 1.0f, 11u}, std::tuple{4000, 2.8f, 12u}}) {
+    SCOPED_TRACE("n " + std::to_string(n) + ", side " + std::to_string(side));
+    const Eigen::Vector3f lo(0.0f, 0.0f, 0.0f), hi = lo + Eigen::Vector3f::Constant(side);
+    Cloud c = random_cloud(std::size_t(n), lo, hi, seed);
+    std::mt19937 rng(seed);
+    for (std::uint32_t& g : c.group) g = rng() % 5 < 4 ? std::uint32_t(rng() % 3) : kNoBody;
+    const HostGrid grid = grid_over(lo, hi, r * 1.0001f);
+    const Sorted s = sort_by_cell(c, grid);
+    std::size_t bodies = 0, ungrouped = 0;
+    check_labels(s, grid, 1, r, static_cast<std::uint32_t>(2 * n), {}, &bodies, true);
+    check_labels(s, grid, 1, r, static_cast<std::uint32_t>(2 * n), {}, &ungrouped, false);
+    EXPECT_GT(bodies, ungrouped) << "the groups split nothing";
+  }
+
+  // Two 4 x 4 x 4 lattices one spacing apart, earlier bodies 0 and 1: two bodies, though every particle of
+  // one face is within the radius of the other's. One particle in no body between them joins them.
+  const float dx = 1.0f;
+  Cloud pair;
+  for (std::uint32_t b = 0; b < 2; ++b)
+    for (int z = 0; z < 4; ++z)
+      for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x)
+          pair.add({float(x + 4 * int(b)) * dx, float(y) * dx, float(z) * dx}, kIce, 1.0f, b);
+  const HostGrid grid = grid_over({-1, -1, -1}, {9, 5, 5}, 1.5f * dx * 1.0001f);
+  std::size_t bodies = 0;
+  check_labels(sort_by_cell(pair, grid), grid, 1, 1.5f * dx, 256, {}, &bodies, true);
+  EXPECT_EQ(bodies, 2u);
+  Cloud bridged = pair;
+  bridged.add({3.5f * dx, 1.0f * dx, 1.0f * dx}, kIce);
+  check_labels(sort_by_cell(bridged, grid), grid, 1, 1.5f * dx, 256, {}, &bodies, true);
+  EXPECT_EQ(bodies, 1u);
+}
+
 // A helix of n ice particles 0.8 r apart with turns 1.5 r apart: a path (no particle has more than two
 // neighbours), the worst case for max propagation.
 Cloud helix_chain(std::size_t n, float r) {
@@ -317,7 +365,7 @@ TEST_F(IceBodiesTest, ChainsConvergeAndPointerJumpsCutSweeps) {
     const HostGrid g = grid_over(lo, hi, r * 1.0001f);
     const Sorted s = sort_by_cell(c, g);
     std::size_t degree = 0;
-    const auto ref = reference_labels(s.p, r, &degree);
+    const auto ref = reference_labels(s.p, r, false, &degree);
     ASSERT_EQ(degree, 2u) << "the helix must be a path";
     ASSERT_TRUE(std::all_of(ref.begin(), ref.end(), [&](std::uint32_t l) { return l == n - 1; }))
         << "one body";

@@ -222,6 +222,37 @@ TEST_F(RigidIceTest, IceRestsOnTheFloorWithoutPassingThrough) {
   EXPECT_NEAR(b.position.z(), 2 * dx, 0.05 * dx);
 }
 
+// Two blocks stacked in air, the upper dropped from three spacings above the lower onto it: it comes to rest
+// a contact distance (one spacing) above it, within the connection radius (1.5 spacings) of it, and a
+// labelling then still finds two bodies: touching ice does not fuse.
+TEST_F(RigidIceTest, StackedBodiesTouchingStayTwoBodies) {
+  const double dx = 0.004;
+  Json doc = drop_scene(dx);
+  doc["ice"] = {
+      {{"material", "ice"}, {"box", box(0.012, 0.012, 0, 0.028, 0.028, 4 * dx)}, {"motion", "free"}},
+      {{"material", "ice"}, {"box", box(0.012, 0.012, 6 * dx, 0.028, 0.028, 10 * dx)}, {"motion", "free"}}};
+  const Scene scene = scene_from_json(doc);
+  Solver solver(cl(), scene, initial_state(scene));
+  solver.warm_up();
+  ASSERT_EQ(solver.rigid_ice()->bodies().size(), 2u);
+  while (solver.time() < 0.4) solver.step();
+  const auto& bodies = solver.rigid_ice()->bodies();
+  ASSERT_EQ(bodies.size(), 2u);
+  const RigidBody& low =
+      bodies[0].body.position.z() < bodies[1].body.position.z() ? bodies[0].body : bodies[1].body;
+  const RigidBody& high = &low == &bodies[0].body ? bodies[1].body : bodies[0].body;
+  // The facing layers are (centre distance - 3 dx) apart: about dx at rest.
+  const double apart = high.position.z() - low.position.z() - 3 * dx;
+  EXPECT_NEAR(apart, dx, 0.1 * dx) << "the upper block is not resting on the lower";
+  EXPECT_LT(high.velocity.norm(), 0.02) << "not at rest";
+  const std::uint64_t before = solver.rigid_ice()->labellings();
+  solver.label_ice();
+  EXPECT_EQ(solver.rigid_ice()->labellings(), before + 1);
+  ASSERT_EQ(solver.rigid_ice()->bodies().size(), 2u) << "touching bodies fused";
+  EXPECT_EQ(solver.rigid_ice()->bodies()[0].particles, 64u);
+  EXPECT_EQ(solver.rigid_ice()->bodies()[1].particles, 64u);
+}
+
 // Held (as a validation case settles its water), a free block stays where it is under gravity; let go,
 // it falls from there.
 TEST_F(RigidIceTest, HeldIceStaysPutUntilLetGo) {
