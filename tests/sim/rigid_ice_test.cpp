@@ -307,6 +307,7 @@ TEST_F(RigidIceTest, BenchBodiesAgreesWithItsReferenceLoops) {
   const Json r = bench_bodies(cl(), o, false);
   EXPECT_TRUE(r["labelling"][0]["labels_match_reference"].get<bool>());
   EXPECT_TRUE(r["labelling"][1]["labels_match_reference"].get<bool>());
+  EXPECT_TRUE(r["grouped_labels_match_reference"].get<bool>());
   EXPECT_TRUE(r["sums_counts_match_reference"].get<bool>());
   EXPECT_LT(r["sums_max_err_of_sum_of_magnitudes"].get<double>(), 1e-6);
   EXPECT_LT(r["ice_forces_max_err_of_largest"].get<double>(), 1e-5);
