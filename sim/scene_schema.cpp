@@ -491,7 +491,7 @@ Floating ice that must turn under small torques (a block righting itself, a narr
 rise through water needs `"solver": {"kernel": "wendland_c2", "support_ratio": 3.0}`. With the default
 cubic spline over 2 spacings the water holds it like a jelly: it stops a few degrees into the turn (the
 `floating` case in docs/VALIDATION-RESULTS.md), and a 2 cm ice cube let go 4 cm under water rises
-1 mm in 0.3 s (2.5 mm spacing), where with Wendland it has risen 7 mm and moves at 38 mm/s. In the
+0.5 mm in 0.3 s (2.5 mm spacing), where with Wendland it has risen 7 mm and moves at 38 mm/s. In the
 floating case Wendland cost 1.5 times as much per particle-step (0.29 against 0.20 µs at res 8) but
 took 1.5 times longer steps, so the wall time per simulated second was the same. It lets water next to walls creep half a spacing into them (the clamp count).
 
