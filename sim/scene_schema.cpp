@@ -190,7 +190,9 @@ const Field& scene_schema() {
                       .def(Json::array()),
                   text("wall_material", "Material of the walls, a solid; required when walls is not empty")
                       .optional(),
-                  integer("wall_layers", "Layers of wall particles; 0 = enough to fill the kernel support")
+                  integer("wall_layers",
+                          "Layers of wall particles; 0 = enough to hold water: one more than the support "
+                          "ratio above 2 spacings (4 at 3), else as many as the support reaches (2 at 2)")
                       .def(0)
                       .at_least(0)
                       .at_most(10),
@@ -483,7 +485,7 @@ always have; every other shape takes the points `domain.min + (i + 1/2) spacing`
 it meets water sampled on that lattice a spacing apart. Inside a mesh is where its generalized winding number exceeds 1/2
 (Jacobson et al. 2013), so a mesh with small holes still fills. Ice leaves out lattice points inside
 solids and earlier ice; fluids leave out points inside solids and ice; solids are sampled only as deep as
-the kernel reaches. Ice is `fixed` (held where it starts; its particles are anchored) or `free`: each
+the walls (`domain.wall_layers`). Ice is `fixed` (held where it starts; its particles are anchored) or `free`: each
 connected piece of ice is a rigid body that the water and contacts move, fixed when any of its
 particles is anchored; a piece that melting cuts loose becomes a body of its own. Shipped meshes live in `configs/meshes/`.
 
@@ -491,9 +493,10 @@ Floating ice that must turn under small torques (a block righting itself, a narr
 rise through water needs `"solver": {"kernel": "wendland_c2", "support_ratio": 3.0}`. With the default
 cubic spline over 2 spacings the water holds it like a jelly: it stops a few degrees into the turn (the
 `floating` case in docs/VALIDATION-RESULTS.md), and a 2 cm ice cube let go 4 cm under water rises
-0.5 mm in 0.3 s (2.5 mm spacing), where with Wendland it has risen 7 mm and moves at 38 mm/s. In the
-floating case Wendland cost 1.5 times as much per particle-step (0.29 against 0.20 µs at res 8) but
-took 1.5 times longer steps, so the wall time per simulated second was the same. It lets water next to walls creep half a spacing into them (the clamp count).
+0.5 mm in 0.3 s (2.5 mm spacing), where with Wendland it has risen 5.8 mm and moves at 29 mm/s.
+Wendland costs more per step and its walls take 4 layers instead of 2, but its steps are longer: the
+`ice-bunny` scene took 335 s of wall time for 1.5 s (56,698 particles, 11,448 steps) against 243 s with
+the cubic spline (40,232 particles, 17,143 steps).
 
 ## Example
 
