@@ -323,5 +323,36 @@ TEST_F(SolverTest, ParticleLeavingTheDomainIsClampedAndCounted) {
   EXPECT_EQ(solver.state().clamped, 1u);
 }
 
+// Walls deep enough to hold water: one layer more than the support ratio above 2 spacings. With 3 layers
+// under Wendland's support of 3 spacings, still water crept into the wall and the domain clamp held it;
+// with the default 4 the clamp never acts.
+TEST_F(SolverTest, WallsHoldStillWaterUnderAWideKernel) {
+  // 5 x 5 cm, 7 cm deep at 5 mm: 1,400 water particles (the clamp starts at about 0.3 s with 3 layers).
+  const std::vector<std::string> wide = {"solver.kernel=wendland_c2", "solver.support_ratio=3",
+                                         "spacing=0.005", "domain.max=[0.05,0.05,0.09]",
+                                         "fluids[0].box.max=[0.05,0.05,0.07]"};
+  auto with = [&](std::vector<std::string> extra) {
+    extra.insert(extra.begin(), wide.begin(), wide.end());
+    return load_scene("hydrostatic-tank", extra);
+  };
+  EXPECT_EQ(wall_layer_count(with({})), 4);
+  EXPECT_EQ(wall_layer_count(with({"solver.support_ratio=3.5"})), 4);
+  EXPECT_EQ(wall_layer_count(load_scene("hydrostatic-tank")), 2);  // cubic spline over 2 spacings
+  EXPECT_EQ(wall_layer_count(load_scene("hydrostatic-tank", {"solver.support_ratio=2.5"})), 3);
+  EXPECT_EQ(wall_layer_count(with({"domain.wall_layers=6"})), 6);
+  std::uint64_t clamped[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    const Scene scene =
+        with(k == 0 ? std::vector<std::string>{"domain.wall_layers=3"} : std::vector<std::string>{});
+    Solver solver(cl(), scene, initial_state(scene));
+    while (solver.time() < 0.6) solver.step();
+    clamped[k] = solver.clamped();
+  }
+  std::printf("clamp events in 0.6 s: %llu with 3 wall layers, %llu with the default 4\n",
+              static_cast<unsigned long long>(clamped[0]), static_cast<unsigned long long>(clamped[1]));
+  EXPECT_GT(clamped[0], 0u) << "3 layers held: the case no longer shows why there are 4";
+  EXPECT_EQ(clamped[1], 0u);
+}
+
 }  // namespace
 }  // namespace thaw
