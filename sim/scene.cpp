@@ -268,6 +268,27 @@ Scene convert_and_check(Json doc, const std::string& folder) {
 
   s.walls = domain["walls"].get<std::vector<std::string>>();
   s.wall_layers = domain["wall_layers"].get<int>();
+  // Walls lie on the lattice that starts at the domain's lower corner. Along an axis with an upper wall,
+  // an extent that is not a whole number of spacings leaves that wall standing off its face: still
+  // water ran into the gap and was clamped there (a 5 cm tank at 4 mm: 484,096 clamps in 0.6 s; at
+  // 4.8 cm, none).
+  for (int a = 0; a < 3; ++a) {
+    bool walled = false;
+    for (const std::string& w : s.walls) walled = walled || (w[0] == '+' && w[1] == "xyz"[a]);
+    if (!walled) continue;
+    const double extent = s.domain.max[a] - s.domain.min[a];
+    const double n = extent / s.spacing;
+    if (std::abs(n - std::round(n)) > 1e-6 * std::max(1.0, n)) {
+      const double below = s.domain.min[a] + std::max(1.0, std::floor(n)) * s.spacing;
+      const double above = s.domain.min[a] + std::ceil(n) * s.spacing;
+      throw SceneError("domain.max",
+                       std::string("the extent along ") + "xyz"[a] + ", " + format_number(extent) +
+                           " m, is " + format_number(n) + " spacings of " + format_number(s.spacing) +
+                           " m; with a wall on its upper side it must be a whole number: set its " +
+                           "xyz"[a] + " to " + format_number(below) + " or " + format_number(above) +
+                           ", or choose a spacing that divides the extent");
+    }
+  }
   if (domain.contains("wall_material")) {
     s.wall_material = material_index(materials, domain["wall_material"], "domain.wall_material", "solid",
                                      "the domain walls");

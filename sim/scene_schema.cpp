@@ -184,7 +184,9 @@ const Field& scene_schema() {
               "domain",
               {
                   vec3("min", "Lower corner").in("m"),
-                  vec3("max", "Upper corner; above min on every axis").in("m"),
+                  vec3("max", "Upper corner; above min on every axis, and a whole number of spacings from it "
+                       "along an axis with a wall on its upper side")
+                      .in("m"),
                   subset("walls", {"-x", "+x", "-y", "+y", "-z", "+z"},
                          "Sides of the domain lined with solid")
                       .def(Json::array()),

@@ -130,7 +130,7 @@ TEST(ThawCli, ShortRunWritesMetricsAndExports) {
   TempDir dir("cli-run");
   const double interval = 0.001;
   const auto r = run_thaw(
-      "run dam-break --steps 5 --set spacing=0.03 --set solver.output_interval=0.001 "
+      "run dam-break --steps 5 --set spacing=0.025 --set solver.output_interval=0.001 "
       "--metrics m.jsonl --export out --every 2 --no-progress",
       dir);
   ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);

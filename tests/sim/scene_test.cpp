@@ -160,6 +160,19 @@ TEST(Scene, NoWallsNeedNoWallMaterial) {
   EXPECT_EQ(scene_from_json(doc).wall_material, -1);
 }
 
+// Walls stand on the lattice from the domain's lower corner: an axis walled on its upper side must span a
+// whole number of spacings (else that wall stands off its face and water runs into the gap). Others need not.
+TEST(Scene, WalledExtentMustBeAWholeNumberOfSpacings) {
+  const SceneError e = scene_error(base_scene(), {"domain.max=[0.405,0.2,0.3]"});
+  EXPECT_EQ(e.path(), "domain.max");
+  EXPECT_NE(message(e).find("the extent along x, 0.405 m, is 40.5 spacings of 0.01 m"), std::string::npos)
+      << e.what();
+  EXPECT_NE(message(e).find("set its x to 0.4 or 0.41"), std::string::npos) << e.what();
+  EXPECT_EQ(scene_error(base_scene(), {"spacing=0.003"}).path(), "domain.max");    // 0.4 m is 133.3 spacings
+  EXPECT_NO_THROW(scene_from_json(base_scene(), {"domain.max=[0.4,0.205,0.3]"}));  // y has no wall
+  EXPECT_NO_THROW(scene_from_json(base_scene(), {"domain.max=[0.4,0.2,0.305]"}));  // -z only: open top
+}
+
 TEST(Scene, WholeNumberAcceptedAsInteger) {
   const Scene s = scene_from_json(base_scene(), {"domain.wall_layers=4.0"});
   EXPECT_EQ(s.wall_layers, 4);
