@@ -126,7 +126,7 @@ struct Scene {
   Box domain;                      // particles leaving it are clamped back and counted
   std::vector<std::string> walls;  // domain sides lined with solid: any of -x +x -y +y -z +z
   int wall_material = -1;          // material of the domain walls (index), -1 when there are none
-  int wall_layers = 0;             // 0 = enough layers to fill the kernel support
+  int wall_layers = 0;             // 0 = as many as hold water (wall_layer_count)
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};
   double spacing = 0.01;  // particle spacing [m]
   SolverSettings solver;
@@ -140,8 +140,8 @@ struct Scene {
   Json source;  // the validated document with every default filled in
 };
 
-// Layers of particles in the domain walls and sampled solids: domain.wall_layers, or enough to fill the
-// kernel support.
+// Layers of particles in the domain walls and sampled solids: domain.wall_layers, or as many as hold water
+// resting on them: one more than the support ratio above 2 spacings (4 at 3), else the ratio rounded up.
 int wall_layer_count(const Scene& s);
 
 // Loads a scene file: reads, applies `--set` overrides, validates, converts.
