@@ -487,9 +487,10 @@ always have; every other shape takes the points `domain.min + (i + 1/2) spacing`
 it meets water sampled on that lattice a spacing apart. Inside a mesh is where its generalized winding number exceeds 1/2
 (Jacobson et al. 2013), so a mesh with small holes still fills. Ice leaves out lattice points inside
 solids and earlier ice; fluids leave out points inside solids and ice; solids are sampled only as deep as
-the walls (`domain.wall_layers`). Ice is `fixed` (held where it starts; its particles are anchored) or `free`: each
-connected piece of ice is a rigid body that the water and contacts move, fixed when any of its
-particles is anchored; a piece that melting cuts loose becomes a body of its own. Shipped meshes live in `configs/meshes/`.
+the walls (`domain.wall_layers`). Ice is `fixed` (held where it starts; its particles are anchored) or
+`free`: each connected piece of ice is a rigid body that the water and contacts move, fixed when any of
+its particles is anchored; a piece that melting cuts loose becomes a body of its own, and bodies that
+come to touch stay apart. Shipped meshes live in `configs/meshes/`.
 
 Floating ice that must turn under small torques (a block righting itself, a narrow one capsizing) or
 rise through water needs `"solver": {"kernel": "wendland_c2", "support_ratio": 3.0}`. With the default

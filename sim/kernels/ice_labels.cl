@@ -44,11 +44,11 @@ int lanes_sum_int16(int16 a) { return lanes_sum_int8(a.lo + a.hi); }
 #define lanes_sum_int THAW_CAT(lanes_sum_int, THAW_VW)
 
 /* Each ice particle's ice neighbours within the radius and in a compatible group (the same one, or either
- * in none: two bodies that come to touch stay two, new ice joins what it touches), in the grid walk's order, in its row of `width`
- * slots (edges[i * width + k]); degree[i] is the full count, and a count beyond the width is reported in
- * overflow[0] (the largest; the atomic runs only then) so the host can widen the rows and walk again.
- * Candidates are tested THAW_VW at a time (SIMD lanes, grid_common.h); the few hits are then written one
- * by one. The labels start as the own id. */
+ * in none: two bodies that come to touch stay two, new ice joins what it touches), in the grid walk's
+ * order, in its row of `width` slots (edges[i * width + k]); degree[i] is the full count, and a count
+ * beyond the width is reported in overflow[0] (the largest; the atomic runs only then) so the host can
+ * widen the rows and walk again. Candidates are tested THAW_VW at a time (SIMD lanes, grid_common.h); the
+ * few hits are then written one by one. The labels start as the own id. */
 kernel void ice_neighbours(global const float* points, const uint stride, global const uint* id,
                            global const uint* cell_start, const Grid g, const float radius, const uint width,
                            global uint* edges, global uint* degree, volatile global uint* overflow,
