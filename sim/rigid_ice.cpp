@@ -266,6 +266,7 @@ RigidIce::Saved RigidIce::save(std::size_t n) const {
     cl_.queue().enqueueReadBuffer(offset_, CL_TRUE, 0, n * 16, s.offset.data());
   }
   s.bodies = {double(labelled_), double(labelled_step_), double(phase_changed_), double(labellings_)};
+  s.labelling = {double(last_iterations_)};
   for (const IceBody& b : bodies_) {
     s.bodies.push_back(double(b.label));
     s.bodies.push_back(double(b.particles));
@@ -288,6 +289,7 @@ void RigidIce::restore(const Saved& s, std::size_t n) {
   labelled_step_ = static_cast<std::uint64_t>(s.bodies[1]);
   phase_changed_ = s.bodies[2] != 0;
   labellings_ = static_cast<std::uint64_t>(s.bodies[3]);
+  last_iterations_ = s.labelling.empty() ? 0 : static_cast<int>(s.labelling[0]);
   bodies_.clear();
   std::size_t k = 4;
   while (k < s.bodies.size()) {

@@ -100,11 +100,12 @@ class RigidIce {
   int last_iterations() const { return last_iterations_; }
 
   // State for state files: per particle (sorted order) the body index and body-frame offset; the bodies
-  // and the labelling schedule as doubles.
+  // and the labelling schedule as doubles; the last labelling's sweeps (empty: 0, as in older files).
   struct Saved {
     std::vector<std::uint32_t> body;
     std::vector<Float4> offset;
     std::vector<double> bodies;
+    std::vector<double> labelling;
   };
   Saved save(std::size_t n) const;
   void restore(const Saved& s, std::size_t n);

@@ -359,7 +359,8 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
       if (p.id[i] < n_) anchored_by_id[p.id[i]] = p.anchored[i];
     rigid_ = std::make_unique<RigidIce>(cl, opts.str(), n_, rigid_settings(scene, k_),
                                         std::move(anchored_by_id), rigid_mass_scales(scene, k_.rest_density));
-    if (!st.rigid_body.empty()) rigid_->restore({st.rigid_body, st.rigid_offset, st.rigid_bodies}, n_);
+    if (!st.rigid_body.empty())
+      rigid_->restore({st.rigid_body, st.rigid_offset, st.rigid_bodies, st.rigid_labelling}, n_);
   }
 }
 
@@ -850,6 +851,7 @@ SimState Solver::state() const {
     s.rigid_body = std::move(r.body);
     s.rigid_offset = std::move(r.offset);
     s.rigid_bodies = std::move(r.bodies);
+    s.rigid_labelling = std::move(r.labelling);
   }
   return s;
 }

@@ -28,6 +28,7 @@ constexpr std::uint32_t kSectionRequired = 1;
 constexpr std::uint32_t kSectionGlobal = 2;
 constexpr const char* kEnergySection = "energy_budget";
 constexpr const char* kBodiesSection = "rigid_bodies";
+constexpr const char* kLabellingSection = "rigid_labelling";
 constexpr std::size_t kPrefixBytes = 8 + 4 + 4;  // magic, version, byte order: the same in every version
 constexpr std::size_t kHeaderBytes = kPrefixBytes + 7 * 8 + 2 * 4 + 8;
 constexpr std::size_t kTrailerBytes = 8;
@@ -173,6 +174,7 @@ template <typename State, typename Visit>
 void for_each_global(State& s, Visit&& visit) {
   visit(kEnergySection, s.energy_budget);
   visit(kBodiesSection, s.rigid_bodies);
+  visit(kLabellingSection, s.rigid_labelling);
 }
 
 // The arrays of one HostParticles must agree in length before they are written.

@@ -24,7 +24,7 @@
 //                  phase, material, id, enthalpy (two floats: hi, lo); where present, anchored (u8:
 //                  particles of fixed ice objects), body (u32) and body_offset (four floats) of runs
 //                  with free ice. Global: energy_budget (doubles, only in runs with heat),
-//                  rigid_bodies (doubles, only in runs with free ice).
+//                  rigid_bodies and rigid_labelling (doubles, only in runs with free ice).
 //   checksum       u64      FNV-1a-64 of every byte before it
 // Arrays are named sections so later versions can add per-particle fields (temperature, enthalpy,
 // body id) without breaking readers: a reader skips unknown optional sections and refuses unknown
@@ -56,6 +56,9 @@ struct SimState {
   std::vector<std::uint32_t> rigid_body;
   std::vector<Float4> rigid_offset;
   std::vector<double> rigid_bodies;
+  // The last labelling's record: its sweeps (global section "rigid_labelling"; files written before it
+  // existed lack it and resume with 0, as before).
+  std::vector<double> rigid_labelling;
 };
 
 // Writes `state` to `path` atomically and durably; throws thaw::Error naming the path and the reason.

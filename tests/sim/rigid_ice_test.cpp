@@ -285,9 +285,12 @@ TEST_F(RigidIceTest, ResumingFromAStateFileIsBitwiseIdentical) {
   Solver a(cl(), scene, st);
   for (int k = 0; k < 8; ++k) a.step();
   const std::string path = (dir.path() / "mid.state").string();
+  const int sweeps = a.rigid_ice()->last_iterations();
+  EXPECT_GT(sweeps, 0);
   write_state_file(path, a.state());
   for (int k = 0; k < 8; ++k) a.step();
   Solver b(cl(), scene, read_state_file(path));
+  EXPECT_EQ(b.rigid_ice()->last_iterations(), sweeps) << "the last labelling's sweeps are part of the state";
   for (int k = 0; k < 8; ++k) b.step();
   const SimState sa = a.state(), sb = b.state();
   EXPECT_EQ(sa.particles.position, sb.particles.position);
@@ -295,7 +298,18 @@ TEST_F(RigidIceTest, ResumingFromAStateFileIsBitwiseIdentical) {
   EXPECT_EQ(sa.rigid_body, sb.rigid_body);
   EXPECT_EQ(sa.rigid_offset, sb.rigid_offset);
   EXPECT_EQ(sa.rigid_bodies, sb.rigid_bodies);
+  EXPECT_EQ(sa.rigid_labelling, sb.rigid_labelling);
   EXPECT_FALSE(sa.rigid_bodies.empty());
+
+  // A file written before the sweeps were saved (no rigid_labelling section) still resumes, with 0.
+  SimState older = read_state_file(path);
+  older.rigid_labelling.clear();
+  const std::string older_path = (dir.path() / "older.state").string();
+  write_state_file(older_path, older);
+  Solver c(cl(), scene, read_state_file(older_path));
+  EXPECT_EQ(c.rigid_ice()->last_iterations(), 0);
+  for (int k = 0; k < 8; ++k) c.step();
+  EXPECT_EQ(c.state().particles.position, sa.particles.position);
 }
 
 // `thaw bench bodies` at a small size: the device's labels, body sums and ice forces agree with its
