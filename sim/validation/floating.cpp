@@ -42,7 +42,11 @@ Field params() {
           number("ice_density", "Ice density").in("kg/m^3").def(917.0).above(0),
           number("water_density", "Water rest density").in("kg/m^3").def(1000.0).above(0),
           number("tilt", "Initial tilt about the y axis").in("degrees").def(10.0).at_least(0).at_most(60),
-          number("margin", "Water beyond the prism's longer side (so a capsized prism keeps it) on each side, in prism heights").def(0.6).above(0),
+          number("margin",
+                 "Water beyond the prism's longer side (so a capsized prism keeps it) on each side, in prism "
+                 "heights")
+              .def(0.6)
+              .above(0),
           number("depth", "Water depth, in prism heights").def(1.5).above(0),
           number("settle_time", "Damped settling of the water (the prism held in place meanwhile)")
               .in("s")
@@ -68,7 +72,8 @@ Field params() {
               .in("degrees")
               .def(6.0)
               .above(0),
-          solver_schema_with({{"artificial_viscosity", 0.05}, {"kernel", "wendland_c2"}, {"support_ratio", 3.0}}),
+          solver_schema_with(
+              {{"artificial_viscosity", 0.05}, {"kernel", "wendland_c2"}, {"support_ratio", 3.0}}),
       });
 }
 
