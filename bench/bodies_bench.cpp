@@ -237,7 +237,7 @@ void reference_sums(const HostParticles& p, const std::vector<Float4>& force,
 // a boundary particle. Contacts are left out: the bench's bodies are a water layer apart.
 void reference_ice_forces(const HostParticles& p, const std::vector<Float4>& state,
                           const std::vector<std::uint32_t>& cell_start, const Solver::GridInfo& g, float H,
-                          float eps2, float visc_boundary, std::vector<Float4>& out) {
+                          float eps2, float visc_boundary, float rho0, std::vector<Float4>& out) {
   const auto n = static_cast<std::uint32_t>(p.size());
   const float inv[3] = {1.0f / g.cells.x(), 1.0f / g.cells.y(), 1.0f / g.cells.z()};
   const int dims[3] = {g.nx, g.ny, g.nz};
@@ -266,7 +266,8 @@ void reference_ice_forces(const HostParticles& p, const std::vector<Float4>& sta
           const float mj = p.position[j][3];
           const float vd = (vi[0] - p.velocity[j][0]) * d[0] + (vi[1] - p.velocity[j][1]) * d[1] +
                            (vi[2] - p.velocity[j][2]) * d[2];
-          const float s = visc_boundary * mj / rho_i * vd / (r2 + eps2) - mj * (dpi + state[j][1]);
+          const float s =
+              visc_boundary * mj * (rho0 / (rho_i * state[j][0])) * vd / (r2 + eps2) - mj * (dpi + state[j][1]);
           const float gf = s * sph::cubic_spline_grad_factor(std::sqrt(r2), H);
           for (int a = 0; a < 3; ++a) f[a] += gf * d[a];
         }
@@ -463,7 +464,7 @@ Json bench_bodies(ClRuntime& cl, const BodiesBenchOptions& o, bool print) {
                        }));
     ref_force_s = std::min(ref_force_s, best_of(1, pause, [&] {
                              reference_ice_forces(p, pstate, cell_start, gi, sc.support, eps2,
-                                                  sc.visc_boundary, ref_force);
+                                                  sc.visc_boundary, sc.rest_density, ref_force);
                            }));
   }
   const std::vector<Float4> dev_force = solver.ice_forces();

@@ -224,7 +224,7 @@ void RigidIce::compute_forces(const ParticleBuffers& p) {
   const float h = static_cast<float>(settings_.smoothing);
   set_args(k_forces_, p.position, p.velocity, p.state, p.phase, body_, bodies_dev_, p.cell_start, p.grid,
            static_cast<float>(settings_.support), 0.01f * h * h, static_cast<float>(settings_.visc_boundary),
-           contact, force_, p.n);
+           static_cast<float>(settings_.rest_density), contact, force_, p.n);
   launch(cl_.queue(), k_forces_, p.n);
 }
 

@@ -64,6 +64,7 @@ class RigidIce {
     double support = 0;        // kernel support H [m]
     double smoothing = 0;      // h [m] (viscosity's eps h^2)
     double visc_boundary = 0;  // the forces pass's boundary viscosity coefficient
+    double rest_density = 0;   // rho0 of the fluid, in the viscous pair term [kg/m^3]
     Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
     ContactModel contact;
     int relabel_interval = 10;  // steps between labellings while ice changes phase

@@ -58,6 +58,7 @@ RigidIce::Settings rigid_settings(const Scene& scene, const SolverConstants& k) 
   r.support = k.support;
   r.smoothing = k.smoothing;
   r.visc_boundary = k.visc_boundary;
+  r.rest_density = k.rest_density;
   r.gravity = scene.gravity;
   r.grid_reach = kGridReach;
   // Contact springs as stiff as the water: k = rho0 c^2 dx oscillates a particle at about c / dx, which
@@ -471,7 +472,7 @@ void Solver::compute_forces() {
   const cl_float4 gravity{
       {float(scene_.gravity.x()), float(scene_.gravity.y()), float(scene_.gravity.z()), 0.f}};
   set_args(k_forces_, position_, velocity_, soa_, derived_, stride_, state_, phase_, cell_start_, g,
-           k_.support, gravity, 0.01f * h * h, accel_, static_cast<cl_uint>(n_));
+           k_.support, gravity, 0.01f * h * h, k_.rest_density, accel_, static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_forces_, n_);
 }
 

@@ -31,13 +31,15 @@ typedef struct {
  * - from water neighbours, the exact opposite of what the forces pass (forces.cl) gives the water from
  *   this particle as a boundary particle, so momentum is exchanged, not made: pressure
  *   -m_b m_i (p_b / rho_b^2 + p_i / rho_i^2) grad W_bi and viscosity
- *   m_b (k_b m_i / rho_b) (v_bi . x_bi) / (r^2 + eps h^2) grad W_bi, k_b the boundary coefficient;
+ *   m_b (k_b m_i rho0 / (rho_b rho_i)) (v_bi . x_bi) / (r^2 + eps h^2) grad W_bi, k_b the boundary
+ *   coefficient (forces.cl's viscous pair term);
  * - contacts with solid particles and ice particles of other bodies.
  * Gravity is added per body on the host, with the body's physical mass. */
 kernel void rigid_forces(global const float4* pos, global const float4* vel, global const float4* state,
                          global const uchar* phase, global const uint* body, global const Body* bodies,
                          global const uint* cell_start, const Grid g, const float H, const float eps2,
-                         const float visc_boundary, const Contact contact, global float4* force, const uint n) {
+                         const float visc_boundary, const float rho0, const Contact contact,
+                         global float4* force, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   const uint b = body[i];
@@ -63,7 +65,7 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
       const float4 sj = state[j];
       const float mj = pos[j].w;
       const float vd = dot(vi.xyz - vel[j].xyz, x);
-      const float s = visc_boundary * mj / rho_i * vd / (r2 + eps2) - mj * (dpi + sj.y);
+      const float s = visc_boundary * mj * (rho0 / (rho_i * sj.x)) * vd / (r2 + eps2) - mj * (dpi + sj.y);
       f_fluid += s * KERNEL_GRAD(sqrt(r2), H) * x;
     } else if (r2 < d2 && (pj == THAW_PHASE_SOLID || (pj == THAW_PHASE_ICE && body[j] != b))) {
       const float r = sqrt(r2);
