@@ -109,6 +109,38 @@ TEST(ThawCli, UnknownValidationCaseNamesTheCases) {
   EXPECT_NE(r.err.find("dam-break"), std::string::npos) << describe(r);
 }
 
+// `thaw bench throughput` and `thaw bench accuracy` end to end, at sizes that take seconds: the
+// throughput JSON has a row per size, and the accuracy sweep writes its table and plot.
+TEST(ThawCli, BenchThroughputPrintsARowPerSize) {
+  TempDir dir("cli-bench-throughput");
+  const auto r = run_thaw("bench throughput --sizes 2000,4000 --steps 1 --json", dir);
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  const Json j = Json::parse(r.out);
+  ASSERT_EQ(j["sizes"].size(), 2u) << r.out;
+  for (const Json& row : j["sizes"]) {
+    EXPECT_GT(row["stage_us"]["step"].get<double>(), 0.0) << row.dump();
+    EXPECT_GT(row["density_ratio"].get<double>(), 0.0) << row.dump();
+  }
+}
+
+TEST(ThawCli, BenchAccuracyWritesItsTableAndPlot) {
+  TempDir dir("cli-bench-accuracy");
+  const auto r = run_thaw("bench accuracy rigid-spin --res 4,6 --set revolutions=1 --out " +
+                              shell_quote(dir / "out") + " --json",
+                          dir);
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  const Json j = Json::parse(r.out);
+  ASSERT_EQ(j["runs"].size(), 2u) << r.out;
+  EXPECT_EQ(j["runs"][0]["res"], 4);
+  EXPECT_EQ(j["runs"][1]["res"], 6);
+  for (const char* file : {"rigid-spin-accuracy.json", "rigid-spin-accuracy.csv", "rigid-spin-accuracy.png"})
+    EXPECT_GT(fs::file_size(fs::path(dir / "out") / file), 100u) << file;
+  std::ifstream csv(fs::path(dir / "out") / "rigid-spin-accuracy.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "case,res,particles,steps,wall_s,metric,value,reference,error,gate");
+}
+
 TEST(ThawCli, InfoNamesADevice) {
   TempDir dir("cli-info");
   const auto r = run_thaw("info", dir);
