@@ -21,7 +21,8 @@ Scene throughput_scene(std::size_t fluid) {
   // Tank 1 x 0.5 x 0.7 m, water 0.6 x 0.5 x 0.6 m in one end: fluid volume 0.18 m^3. The walled
   // extents (length and width) are rounded to whole spacings, as walls need; the water fills the width.
   const double dx = std::cbrt(0.18 / double(fluid));
-  const double length = std::max(2.0, std::round(1.0 / dx)) * dx, width = std::max(1.0, std::round(0.5 / dx)) * dx;
+  const double length = std::max(2.0, std::round(1.0 / dx)) * dx,
+               width = std::max(1.0, std::round(0.5 / dx)) * dx;
   TankScene t{"bench/throughput", {length, width, 0.7}, {0.6, width, 0.6}, dx};
   t.heat = true;  // the whole step: water and heat (ambient air and conduction into the walls)
   return scene_from_json(tank_scene_json(t));

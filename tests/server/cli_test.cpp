@@ -125,9 +125,9 @@ TEST(ThawCli, BenchThroughputPrintsARowPerSize) {
 
 TEST(ThawCli, BenchAccuracyWritesItsTableAndPlot) {
   TempDir dir("cli-bench-accuracy");
-  const auto r = run_thaw("bench accuracy rigid-spin --res 4,6 --set revolutions=1 --out " +
-                              shell_quote(dir / "out") + " --json",
-                          dir);
+  const auto r = run_thaw(
+      "bench accuracy rigid-spin --res 4,6 --set revolutions=1 --out " + shell_quote(dir / "out") + " --json",
+      dir);
   ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
   const Json j = Json::parse(r.out);
   ASSERT_EQ(j["runs"].size(), 2u) << r.out;

@@ -1,11 +1,10 @@
 // `thaw bench throughput`: its scene is valid at any requested size, and at small sizes the bench runs
 // and its hand-written reference loops agree with the device (the timings are not asserted).
-#include "bench/throughput.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "bench/throughput.h"
 #include "sim/error.h"
 #include "tests/test_support.h"
 
