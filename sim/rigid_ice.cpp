@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <limits>
 #include <map>
 
 #include "sim/cl_launch.h"
@@ -163,6 +164,8 @@ void RigidIce::relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool
 
   std::vector<IceBody> bodies;
   bodies.reserve(members.size());
+  std::vector<std::vector<Eigen::Vector3f>> shapes;
+  shapes.reserve(members.size());
   std::vector<std::uint32_t> body(n, kNoBody);
   std::vector<Float4> offset(n, Float4{0.f, 0.f, 0.f, 0.f});
   for (const auto& [lab, idx] : members) {
@@ -201,14 +204,17 @@ void RigidIce::relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool
     ib.body = rigid_body(mp, velocity, omega);
     ib.body.fixed = fixed;
     const std::uint32_t b = static_cast<std::uint32_t>(bodies.size());
+    std::vector<Eigen::Vector3f> shape(idx.size());
     for (std::size_t k = 0; k < idx.size(); ++k) {
       body[idx[k]] = b;
-      const Eigen::Vector3d& o = mp.offsets[k];
-      offset[idx[k]] = Float4{float(o.x()), float(o.y()), float(o.z()), 0.f};
+      shape[k] = mp.offsets[k].cast<float>();
+      offset[idx[k]] = Float4{shape[k].x(), shape[k].y(), shape[k].z(), 0.f};
     }
     bodies.push_back(std::move(ib));
+    shapes.push_back(std::move(shape));
   }
   bodies_ = std::move(bodies);
+  shapes_ = std::move(shapes);
   q.enqueueWriteBuffer(body_, CL_FALSE, 0, n * 4, body.data());
   q.enqueueWriteBuffer(offset_, CL_TRUE, 0, n * 16, offset.data());
   upload_bodies();
@@ -245,10 +251,38 @@ void RigidIce::advance(const ParticleBuffers& p, double dt) {
     RigidBody& r = bodies_[b].body;
     if (r.fixed || held_) continue;
     thaw::advance(r, sums[b].force + r.mass * settings_.gravity, sums[b].torque, dt);
+    if (confine(b)) ++clamped_;
   }
   upload_bodies();
   set_args(k_place_, p.position, p.velocity, p.phase, body_, offset_, bodies_dev_, p.n);
   launch(cl_.queue(), k_place_, p.n);
+}
+
+bool RigidIce::confine(std::size_t b) {
+  RigidBody& r = bodies_[b].body;
+  const Eigen::Matrix3d R = r.orientation.toRotationMatrix();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Eigen::Vector3f& o : shapes_[b]) {
+    const Eigen::Vector3d x = r.position + R * o.cast<double>();
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  bool moved = false;
+  for (int a = 0; a < 3; ++a) {
+    // A body wider than the domain cannot fit; it is kept off the lower face.
+    if (hi[a] > settings_.domain_max[a]) {
+      r.position[a] -= hi[a] - settings_.domain_max[a];
+      r.velocity[a] = std::min(r.velocity[a], 0.0);
+      lo[a] -= hi[a] - settings_.domain_max[a];
+      moved = true;
+    }
+    if (lo[a] < settings_.domain_min[a]) {
+      r.position[a] += settings_.domain_min[a] - lo[a];
+      r.velocity[a] = std::max(r.velocity[a], 0.0);
+      moved = true;
+    }
+  }
+  return moved;
 }
 
 std::vector<Float4> RigidIce::forces(std::size_t n) const {
@@ -266,7 +300,13 @@ RigidIce::Saved RigidIce::save(std::size_t n) const {
     cl_.queue().enqueueReadBuffer(offset_, CL_TRUE, 0, n * 16, s.offset.data());
   }
   s.bodies = {double(labelled_), double(labelled_step_), double(phase_changed_), double(labellings_)};
+  // The last labelling's sweeps, then each body's shape as that labelling left it (particles that have
+  // melted since included, as the running solver has it): its particle count and their offsets.
   s.labelling = {double(last_iterations_)};
+  for (const auto& shape : shapes_) {
+    s.labelling.push_back(double(shape.size()));
+    for (const Eigen::Vector3f& o : shape) s.labelling.insert(s.labelling.end(), {o.x(), o.y(), o.z()});
+  }
   for (const IceBody& b : bodies_) {
     s.bodies.push_back(double(b.label));
     s.bodies.push_back(double(b.particles));
@@ -305,6 +345,23 @@ void RigidIce::restore(const Saved& s, std::size_t n) {
         body_from_vector(std::vector<double>(s.bodies.begin() + long(k), s.bodies.begin() + long(k + len)));
     k += len;
     bodies_.push_back(std::move(b));
+  }
+  shapes_.assign(bodies_.size(), {});
+  if (s.labelling.size() > 1) {
+    std::size_t at = 1;
+    for (auto& shape : shapes_) {
+      if (at >= s.labelling.size()) throw Error("rigid ice state: the body shapes are cut short");
+      const auto count = static_cast<std::size_t>(s.labelling[at++]);
+      if (at + 3 * count > s.labelling.size()) throw Error("rigid ice state: the body shapes are cut short");
+      for (std::size_t j = 0; j < count; ++j, at += 3)
+        shape.emplace_back(float(s.labelling[at]), float(s.labelling[at + 1]), float(s.labelling[at + 2]));
+    }
+    if (at != s.labelling.size()) throw Error("rigid ice state: the body shapes do not match the bodies");
+  } else {
+    // Files written before the shapes were kept: each body's particles now.
+    for (std::size_t i = 0; i < n; ++i)
+      if (s.body[i] < bodies_.size())
+        shapes_[s.body[i]].emplace_back(s.offset[i][0], s.offset[i][1], s.offset[i][2]);
   }
   upload_bodies();
 }

@@ -12,6 +12,10 @@
 // its body at once and a frozen one stays in place until the next labelling adopts it. Bodies that merely
 // touch stay apart: a labelling connects particles of one body, or a particle in none (the first
 // labelling's, newly frozen ones), never two of different bodies.
+//
+// A free body stays inside the domain, as water does: a body that a step would carry past a face (an
+// open side, or a fall past the edge of a floor) is moved back onto it, its velocity out of the face
+// removed, and the event counted with the solver's clamps.
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
@@ -66,6 +70,8 @@ class RigidIce {
     double visc_boundary = 0;  // the forces pass's boundary viscosity coefficient
     double rest_density = 0;   // rho0 of the fluid, in the viscous pair term [kg/m^3]
     Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d domain_min = Eigen::Vector3d::Constant(-1e30);  // particle centres stay in it [m]
+    Eigen::Vector3d domain_max = Eigen::Vector3d::Constant(1e30);
     ContactModel contact;
     int relabel_interval = 10;  // steps between labellings while ice changes phase
     int grid_reach = 1;         // cells the neighbour walk visits on each side (Solver::GridInfo::reach)
@@ -98,6 +104,8 @@ class RigidIce {
   // The force on each particle from the last compute_forces() [N] (benchmarks and tests).
   std::vector<Float4> forces(std::size_t n) const;
   std::uint64_t labellings() const { return labellings_; }
+  // Times a free body was moved back inside the domain since this object was made.
+  std::uint64_t clamped() const { return clamped_; }
   int last_iterations() const { return last_iterations_; }
 
   // State for state files: per particle (sorted order) the body index and body-frame offset; the bodies
@@ -113,6 +121,8 @@ class RigidIce {
 
  private:
   void upload_bodies();
+  // Moves body b back inside the domain if any of its particles left it; true if it did.
+  bool confine(std::size_t b);
 
   ClRuntime& cl_;
   Settings settings_;
@@ -124,12 +134,14 @@ class RigidIce {
   cl::Buffer body_, spare_body_, offset_, spare_offset_, force_, label_, bodies_dev_, refs_;
   std::size_t bodies_capacity_ = 0;
   std::vector<IceBody> bodies_;
+  std::vector<std::vector<Eigen::Vector3f>> shapes_;  // each body's particle offsets in its own frame
   bool phase_changed_ = false;
   bool held_ = false;
   bool labelled_ = false;
   std::uint64_t labelled_step_ = 0;
   std::uint64_t labellings_ = 0;
   int last_iterations_ = 0;
+  std::uint64_t clamped_ = 0;
 };
 
 }  // namespace thaw

@@ -218,7 +218,8 @@ const Field& scene_schema() {
                       },
                       "Heat exchange of the tank walls with the outside (Domaradzki & Martyn sec. 7)."),
               },
-              "The simulated box; particles that leave it are clamped back and counted."),
+              "The simulated box; particles that leave it are clamped back and counted (a free ice body is "
+              "moved back whole)."),
           vec3("gravity", "Gravitational acceleration").in("m/s^2").def({0.0, 0.0, -9.81}).client_settable(),
           number("spacing", "Particle spacing; sets the resolution").in("m").above(0),
           solver_schema(),

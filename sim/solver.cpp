@@ -60,6 +60,8 @@ RigidIce::Settings rigid_settings(const Scene& scene, const SolverConstants& k) 
   r.visc_boundary = k.visc_boundary;
   r.rest_density = k.rest_density;
   r.gravity = scene.gravity;
+  r.domain_min = scene.domain.min;
+  r.domain_max = scene.domain.max;
   r.grid_reach = kGridReach;
   // Contact springs as stiff as the water: k = rho0 c^2 dx oscillates a particle at about c / dx, which
   // the acoustic time step already resolves, and a resting body sinks into a floor by only
@@ -820,7 +822,7 @@ std::vector<float> Solver::temperatures() const {
 std::uint64_t Solver::clamped() const {
   cl_uint c = 0;
   cl_.queue().enqueueReadBuffer(clamped_, CL_TRUE, 0, 4, &c);
-  return clamped_base_ + c;
+  return clamped_base_ + c + (rigid_ ? rigid_->clamped() : 0);
 }
 
 HostParticles Solver::particles() const {

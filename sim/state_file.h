@@ -56,8 +56,9 @@ struct SimState {
   std::vector<std::uint32_t> rigid_body;
   std::vector<Float4> rigid_offset;
   std::vector<double> rigid_bodies;
-  // The last labelling's record: its sweeps (global section "rigid_labelling"; files written before it
-  // existed lack it and resume with 0, as before).
+  // The last labelling's record (global section "rigid_labelling"): its sweeps, then each body's shape,
+  // its particle count and their body-frame offsets, which keep it inside the domain. Files written
+  // before the section existed resume with 0 sweeps, and before the shapes, with each body's particles.
   std::vector<double> rigid_labelling;
 };
 
