@@ -129,6 +129,12 @@ SolverConstants derive_constants(const Scene& scene) {
   k.visc_fluid =
       static_cast<float>(s.artificial_viscosity * k.sound_speed * h + 10.0 * k.kinematic_viscosity);
   k.visc_boundary = static_cast<float>(s.boundary_viscosity * k.sound_speed * h);
+  {
+    const double dx = scene.spacing;
+    k.repulsion = static_cast<float>(c2 / (dx * dx * k.rest_density * dx * dx * dx));
+    k.repulsion_range = static_cast<float>(0.95 * dx);
+    k.repulsion_damping = static_cast<float>(dx / k.sound_speed);
+  }
 
   const double inf = std::numeric_limits<double>::infinity();
   const double alpha = max_diffusivity(scene);
@@ -290,10 +296,10 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   spare_mat_ = buf(n);
   spare_id_ = buf(n * 4);
   soa_ = buf(std::size_t(stride_) * 7 * 4);
-  derived_ = buf(std::size_t(stride_) * 2 * 4);
+  derived_ = buf(std::size_t(stride_) * 3 * 4);
   // The padding past the last particle is read by masked lanes only; keep it finite anyway.
   cl.queue().enqueueFillBuffer(soa_, 0.0f, 0, std::size_t(stride_) * 7 * 4);
-  cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(stride_) * 2 * 4);
+  cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(stride_) * 3 * 4);
   enthalpy_ = buf(n * 8);
   spare_enthalpy_ = buf(n * 8);
   if (heat_) {
@@ -474,7 +480,8 @@ void Solver::compute_forces() {
   const cl_float4 gravity{
       {float(scene_.gravity.x()), float(scene_.gravity.y()), float(scene_.gravity.z()), 0.f}};
   set_args(k_forces_, position_, velocity_, soa_, derived_, stride_, state_, phase_, cell_start_, g,
-           k_.support, gravity, 0.01f * h * h, k_.rest_density, accel_, static_cast<cl_uint>(n_));
+           k_.support, gravity, 0.01f * h * h, k_.rest_density, k_.repulsion, k_.repulsion_range,
+           k_.repulsion_damping, accel_, static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_forces_, n_);
 }
 

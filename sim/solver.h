@@ -30,6 +30,10 @@ struct SolverConstants {
   // Viscosity coefficients of the forces pass: 2(d+2) nu + alpha c h between fluid particles (Monaghan
   // 2005 eq. 4.8 and its artificial-viscosity equivalent), alpha_b c h against boundary particles.
   float visc_fluid = 0, visc_boundary = 0;
+  // Solid particles push fluid particles closer than repulsion_range (0.95 dx) apart, a spring of pair
+  // stiffness m_i m_b repulsion [1/(kg s^2)] = c^2 / (dx^2 rho0 dx^3), as stiff as the ice contacts, with
+  // a dashpot of time repulsion_damping = dx / c [s] (forces.cl).
+  float repulsion = 0, repulsion_range = 0, repulsion_damping = 0;
   // Heat: the diffusion limit on dt [s] (infinite without conduction), and the smallest heat capacity
   // per exposed area rho c dx / 6 over the materials that exchange heat with the air [J/m^2/K].
   double diffusion_dt = 0;

@@ -3,8 +3,8 @@
  * pressure the fluid presses on them with (see forces.cl). state_i = (rho, p / rho^2, is_boundary, p).
  * Candidates are read THAW_VW at a time (SIMD lanes: grid_common.h) from the structure-of-arrays copy
  * `soa` the reorder writes (x, y, z, m blocks of `stride` floats). Also writes the per-particle factors of the
- * forces pass's pair terms: derived = (k_j m_j / rho_j, m_j p_j / rho_j^2) blocks, k_j the viscosity
- * coefficient of the particle's kind (fluid or boundary). */
+ * forces pass's pair terms: derived = (k_j m_j / rho_j, m_j p_j / rho_j^2, solid ? m_j : 0) blocks,
+ * k_j the viscosity coefficient of the particle's kind (fluid or boundary). */
 
 kernel void density(global const float4* pos, global const float* soa, const uint stride,
                     global const uchar* phase, global const uint* cell_start, const Grid g, const float H,
@@ -56,4 +56,5 @@ kernel void density(global const float4* pos, global const float* soa, const uin
   state[i] = (float4)(rho, dp, boundary ? 1.0f : 0.0f, p);
   derived[i] = (boundary ? visc_boundary : visc_fluid) * pi.w / rho;
   derived[stride + i] = pi.w * dp;
+  derived[2 * stride + i] = phase[i] == THAW_PHASE_SOLID ? pi.w : 0.0f;
 }

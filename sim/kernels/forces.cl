@@ -5,6 +5,14 @@
  * (at a free surface, between water and meltwater), so viscosity moves momentum, never makes it. With
  * 1/rho_j alone a zero-gravity ball of water lost 0.3 % of an ice block's momentum in 300 steps
  * (RigidIceTest.IceAndWaterKeepTheirTotalMomentumWithViscosity). rigid.cl's reaction on ice matches.
+ * Solid particles (walls, static solids; not ice) also push a fluid particle closer than rep_r0 (0.95
+ * spacings) straight away, a spring and dashpot as stiff as the ice contacts (rigid.cl) that pushes,
+ * never pulls:
+ * m_i m_b K max((r0 - r) / r - D (v_ij . x_ij) / r^2, 0) x_ij, K = c^2 / (dx^2 rho0 dx^3), D = dx / c
+ * (half the critical damping of two particles of mass rho0 dx^3). Water in bulk keeps a spacing from
+ * walls and does not feel it, but a lone drop has too little density for pressure: it sank half a
+ * spacing into a wall, onto the domain's face, where the clamp caught it every step
+ * (SolverTest.LoneDropsRestOnAWallWithoutTheClamp).
  * Boundary particles (mass Psi_b, Akinci et al. 2012) enter with their own summation density and
  * pressure (see density.cl), so the pressure force is exactly the gradient of the total internal
  * energy and the system stays conservative: a damped state settles. Akinci's one-sided term
@@ -16,11 +24,18 @@
  * structure-of-arrays copy (x, y, z, m, vx, vy, vz) and the per-particle factors the density pass
  * wrote (derived: k_j m_j / rho_j, m_j p_j / rho_j^2). */
 
+/* The boundary push's factor of x_ij (without m_b K): zero beyond r0, never negative. */
+floatV repulsion(const floatV r, const floatV r2, const floatV vd, const float r0, const float d) {
+  const floatV safe = fmax(r, 1e-20f);
+  const floatV f = fmax((r0 - r) / safe - d * vd / (safe * safe), 0.0f);
+  return select((floatV)(0.0f), f, r < r0);
+}
+
 kernel void forces(global const float4* pos, global const float4* vel, global const float* soa,
                    global const float* derived, const uint stride, global const float4* state,
                    global const uchar* phase, global const uint* cell_start, const Grid g, const float H,
-                   const float4 gravity, const float eps2, const float rho0, global float4* accel,
-                   const uint n) {
+                   const float4 gravity, const float eps2, const float rho0, const float rep_k,
+                   const float rep_r0, const float rep_d, global float4* accel, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   if (THAW_IS_STATIC(phase[i])) {
@@ -43,6 +58,9 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
   global const float* VZ = soa + 6 * stride;
   global const float* KV = derived;
   global const float* MP = derived + stride;
+  global const float* RB = derived + 2 * stride; /* m_j for solid particles, 0 for the rest */
+  const float scale = THAW_SIGMA(H) * inv_H * inv_H;
+  const float rep = rep_k / scale; /* the sum below is scaled by `scale` at the end */
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
     for (uint j = jb; j < je; j += THAW_VW) {
@@ -56,16 +74,17 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
       /* -m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W
        *   + k (m_j/rho_j) (rho0/rho_i) (v_ij . x_ij)/(r^2 + eps h^2) grad W,
        * grad W = grad_factor x_ij with grad_factor = sigma / H^2 grad_shape(q). */
+      const floatV r = sqrt(r2);
       const floatV s =
-          grad_shape(sqrt(r2) * inv_H) *
-          (vloadV(0, KV + j) * (visc_i * vd) / (r2 + eps2) - (vloadV(0, M + j) * dpi + vloadV(0, MP + j)));
+          grad_shape(r * inv_H) *
+              (vloadV(0, KV + j) * (visc_i * vd) / (r2 + eps2) - (vloadV(0, M + j) * dpi + vloadV(0, MP + j))) +
+          rep * vloadV(0, RB + j) * repulsion(r, r2, vd, rep_r0, rep_d);
       /* Masked after the products: lanes past the row may hold any particle's (even non-finite) data. */
       ax += select((floatV)(0.0f), s * dx, in);
       ay += select((floatV)(0.0f), s * dy, in);
       az += select((floatV)(0.0f), s * dz, in);
     }
   })
-  const float scale = THAW_SIGMA(H) * inv_H * inv_H;
   const float3 a = scale * (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
   accel[i] = (float4)(a + gravity.xyz, 0.0f);
 }
