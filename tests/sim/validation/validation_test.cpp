@@ -176,7 +176,7 @@ TEST_F(Validation, FloatingWidePrismRightsItselfAtArchimedesDraft) {
 
 // A narrow prism (breadth = height / 2) is unstable upright: let go at 10 degrees it capsizes and comes to
 // rest on its side (reference 90 degrees, from the righting arm). A smaller tank than the case's default
-// keeps it to 18,734 particles; at 12 particles across the height it reached 85.9 degrees after 2.5 s
+// keeps it to 18,734 particles; at 12 particles across the height it reached 85.1 degrees after 2.5 s
 // (at 8 across, in the default tank, water perched on the nearly level upper face held it at 37 degrees
 // after 3 s; docs/VALIDATION-RESULTS.md).
 TEST_F(Validation, FloatingNarrowPrismCapsizesOntoItsSide) {
