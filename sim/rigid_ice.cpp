@@ -260,6 +260,11 @@ void RigidIce::advance(const ParticleBuffers& p, double dt) {
 
 bool RigidIce::confine(std::size_t b) {
   RigidBody& r = bodies_[b].body;
+  // Most steps every body is further than its radius from every face: no need to visit its particles.
+  const double reach = bodies_[b].radius * (1.0 + 1e-6);
+  if ((r.position - settings_.domain_min).minCoeff() >= reach &&
+      (settings_.domain_max - r.position).minCoeff() >= reach)
+    return false;
   const Eigen::Matrix3d R = r.orientation.toRotationMatrix();
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const Eigen::Vector3f& o : shapes_[b]) {

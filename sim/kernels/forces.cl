@@ -22,7 +22,7 @@
  * configs/hydrostatic-tank.json and `thaw validate hydrostatic`.
  * Candidates are read THAW_VW at a time (SIMD lanes: grid_common.h) from the reorder's
  * structure-of-arrays copy (x, y, z, m, vx, vy, vz) and the per-particle factors the density pass
- * wrote (derived: k_j m_j / rho_j, m_j p_j / rho_j^2). */
+ * wrote (derived: k_j m_j / rho_j, m_j p_j / rho_j^2, and m_j for solid particles). */
 
 /* The boundary push's factor of x_ij (without m_b K): zero beyond r0, never negative. */
 floatV repulsion(const floatV r, const floatV vd, const float r0, const float d) {
