@@ -452,7 +452,8 @@ int wall_layer_count(const Scene& s) {
   if (s.wall_layers > 0) return s.wall_layers;
   // Over a support of 3 spacings, 3 layers let water under load creep into the wall (its deepest layer is
   // just out of reach of water resting on it, and the wall particles it does reach are short of
-  // neighbours below); one more holds it. Over 2, 2 held as well as 3. Measured in docs/SCENES.md.
+  // neighbours below) until the walls' short-range push (forces.cl) came; the fourth still fills the
+  // kernel's support next to the wall. Over 2, 2 held as well as 3. Measured in docs/VALIDATION-RESULTS.md.
   const double r = s.solver.support_ratio;
   return r > 2.0 + 1e-9 ? static_cast<int>(std::floor(r + 1e-9)) + 1 : static_cast<int>(std::ceil(r - 1e-9));
 }

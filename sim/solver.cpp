@@ -129,12 +129,10 @@ SolverConstants derive_constants(const Scene& scene) {
   k.visc_fluid =
       static_cast<float>(s.artificial_viscosity * k.sound_speed * h + 10.0 * k.kinematic_viscosity);
   k.visc_boundary = static_cast<float>(s.boundary_viscosity * k.sound_speed * h);
-  {
-    const double dx = scene.spacing;
-    k.repulsion = static_cast<float>(c2 / (dx * dx * k.rest_density * dx * dx * dx));
-    k.repulsion_range = static_cast<float>(0.95 * dx);
-    k.repulsion_damping = static_cast<float>(dx / k.sound_speed);
-  }
+  const double dx = scene.spacing;
+  k.repulsion = static_cast<float>(c2 / (dx * dx * k.rest_density * dx * dx * dx));
+  k.repulsion_range = static_cast<float>(0.95 * dx);
+  k.repulsion_damping = static_cast<float>(dx / k.sound_speed);
 
   const double inf = std::numeric_limits<double>::infinity();
   const double alpha = max_diffusivity(scene);
@@ -143,7 +141,6 @@ SolverConstants derive_constants(const Scene& scene) {
   // dt < rho c dx / (6 h); the time step keeps half of that (Solver::heat_time_step).
   k.exposed_capacity = inf;
   k.wall_dt = inf;
-  const double dx = scene.spacing;
   for (const Material& m : scene.materials) {
     if (m.kind != "solid")
       k.exposed_capacity = std::min(k.exposed_capacity, m.density * m.specific_heat * dx / 6.0);

@@ -75,4 +75,17 @@ Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaul
   return f;
 }
 
+Line least_squares_line(const std::vector<double>& x, const std::vector<double>& y,
+                        const std::vector<double>& w) {
+  double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const double wk = w.empty() ? 1.0 : w[k];
+    sw += wk, sx += wk * x[k], sy += wk * y[k], sxx += wk * x[k] * x[k], sxy += wk * x[k] * y[k];
+  }
+  Line l;
+  l.slope = (sw * sxy - sx * sy) / (sw * sxx - sx * sx);
+  l.intercept = (sy - l.slope * sx) / sw;
+  return l;
+}
+
 }  // namespace thaw

@@ -58,4 +58,12 @@ ValidationCase floating_case();
 namespace thaw {
 // solver_schema() with some defaults changed, for a case that needs other solver defaults.
 Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaults);
+
+// The weighted least-squares line y = intercept + slope x through the points (x[k], y[k]), weights w[k]
+// (all 1 when w is empty). Needs two distinct x.
+struct Line {
+  double slope = 0, intercept = 0;
+};
+Line least_squares_line(const std::vector<double>& x, const std::vector<double>& y,
+                        const std::vector<double>& w = {});
 }  // namespace thaw

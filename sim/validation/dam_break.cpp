@@ -33,19 +33,6 @@ double martin_moyce(double t_star) {
   return kFront.back();
 }
 
-// The least-squares slope dZ/dT* through the points (t[k], z[k]).
-double slope(const std::vector<double>& t, const std::vector<double>& z) {
-  const double n = double(t.size());
-  double st = 0, sz = 0, stt = 0, stz = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    st += t[k];
-    sz += z[k];
-    stt += t[k] * t[k];
-    stz += t[k] * z[k];
-  }
-  return (n * stz - st * sz) / (n * stt - st * st);
-}
-
 Field params() {
   return object(
       "", {
@@ -133,7 +120,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   // through the same times, against the slope through Martin & Moyce's curve there. It tells a front
   // that moves at the experiment's pace from some earlier start (the experiment's gate took time to
   // open) from one that runs at the wrong speed.
-  const double speed = slope(samples, measured), ref_speed = slope(samples, refs);
+  const double speed = least_squares_line(samples, measured).slope;
+  const double ref_speed = least_squares_line(samples, refs).slope;
   r.metrics.push_back(
       {"front_speed_dZ/dT*", {speed, ref_speed, std::abs(speed - ref_speed) / ref_speed, prm["gate"]}});
   return r;

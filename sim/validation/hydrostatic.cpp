@@ -107,17 +107,18 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   // with the exact profile over the interior. Single layers deviate from it by the WCSPH pressure noise
   // c^2 delta_rho (1 % of rho0 g H is a density deviation of ~4e-5 here), reported as its own metric.
   const double scale = rho0 * g * H;
-  double sw = 0, sz = 0, sp = 0, szz = 0, szp = 0, zlo = 1e300, zhi = -1e300;
+  std::vector<double> zs, ps, ws;
+  double zlo = 1e300, zhi = -1e300;
   for (int l = 0; l < layers; ++l) {
     if (cnt[l] == 0) continue;
     const double w = double(cnt[l]), zm = sum_z[l] / w, pm = sum_p[l] / w;
-    sw += w, sz += w * zm, sp += w * pm, szz += w * zm * zm, szp += w * zm * pm;
+    zs.push_back(zm), ps.push_back(pm), ws.push_back(w);
     zlo = std::min(zlo, zm), zhi = std::max(zhi, zm);
   }
-  if (sw == 0 || zhi - zlo < dx)
+  if (zs.empty() || zhi - zlo < dx)
     throw SceneError("interior_margin",
                      "no interior left to measure: widen the tank (width) or lower interior_margin");
-  const double slope = (sw * szp - sz * sp) / (sw * szz - sz * sz), intercept = (sp - slope * sz) / sw;
+  const auto [slope, intercept] = least_squares_line(zs, ps, ws);
   MetricResult profile{0, 0, 0, prm["pressure_gate"]};
   for (double z : {zlo, zhi}) {  // a line against a (nearly linear) exact profile: worst at an end
     const double fit = intercept + slope * z, exact = prof.pressure_at(z);
