@@ -14,6 +14,7 @@
 #include "server/commands.h"
 #include "server/protocol.h"
 #include "sim/error.h"
+#include "sim/json_text.h"
 #include "sim/schema.h"
 
 namespace thaw {
@@ -90,7 +91,8 @@ int ctl_callback(lws* wsi, lws_callback_reasons reason, void*, void* in, std::si
 int cmd_ctl(int argc, char** argv) {
   CliArgs args(argc, argv, 2, {"--token", "--timeout"}, {});
   if (args.positional().empty())
-    throw Error("ctl needs a URL, e.g. ws://127.0.0.1:8080/, then JSON commands such as '{\"type\": \"sim.pause\"}'");
+    throw Error(
+        "ctl needs a URL, e.g. ws://127.0.0.1:8080/, then JSON commands such as '{\"type\": \"sim.pause\"}'");
   const std::string url = args.positional()[0];
   // ws://HOST:PORT/PATH
   const std::string prefix = "ws://";
@@ -115,8 +117,10 @@ int cmd_ctl(int argc, char** argv) {
   for (std::size_t i = 1; i < args.positional().size(); ++i) {
     Json command;
     try {
-      command = Json::parse(args.positional()[i]);
-    } catch (const std::exception& e) {
+      command = parse_json(args.positional()[i]);
+    } catch (const JsonShapeError& e) {
+      throw Error("ctl: command " + std::to_string(i) + ": " + e.what());
+    } catch (const std::exception&) {
       throw Error("ctl: command " + std::to_string(i) + " is not JSON: " + args.positional()[i]);
     }
     if (!command.is_object()) throw Error("ctl: command " + std::to_string(i) + " is not a JSON object");

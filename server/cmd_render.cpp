@@ -9,6 +9,7 @@
 #include "server/commands.h"
 #include "server/render_options.h"
 #include "sim/error.h"
+#include "sim/json_text.h"
 #include "sim/state_file.h"
 #include "sim/thermal.h"
 
@@ -24,7 +25,7 @@ int cmd_render(int argc, char** argv) {
   const RenderOptions o = render_options(args);
 
   const SimState state = read_state_file(args.positional()[0]);
-  const Scene scene = scene_from_json(Json::parse(state.scene_json));
+  const Scene scene = scene_from_json(parse_json(state.scene_json));
   const RenderSnapshot snap =
       make_snapshot(state.particles, temperatures_of(state.particles, scene), scene, state.time, state.step);
 

@@ -15,6 +15,7 @@
 #include "server/progress.h"
 #include "server/render_options.h"
 #include "sim/error.h"
+#include "sim/json_text.h"
 #include "sim/metrics.h"
 #include "sim/particle_export.h"
 #include "sim/solver.h"
@@ -61,7 +62,7 @@ int cmd_run(int argc, char** argv) {
         std::fprintf(stderr, "note: scene differs from the one stored in %s; continuing with %s\n",
                      state_in->c_str(), args.positional()[0].c_str());
     } else {
-      scene = scene_from_json(Json::parse(start.scene_json), args.sets());
+      scene = scene_from_json(parse_json(start.scene_json), args.sets());
     }
   } else {
     scene = load_scene(args.positional()[0], args.sets());

@@ -16,13 +16,13 @@
 #include <vector>
 
 #include "sim/error.h"
+#include "sim/json_text.h"
 #include "sim/scene.h"
 
 namespace thaw::protocol {
 namespace {
 
 constexpr int kMaxIndex = 63;              // dryers and lamps a client may address
-constexpr std::size_t kMaxDepth = 32;      // nesting; commands need 3, this keeps recursion shallow
 constexpr std::size_t kMaxIdChars = 256;   // echoed in every reply, so kept short
 constexpr std::size_t kMaxNameChars = 64;  // scene and state names
 constexpr std::size_t kMaxPathChars = 256;
@@ -65,30 +65,6 @@ std::string shown(const std::string& s) {
   std::string q = Json(s).dump(-1, ' ', true, Json::error_handler_t::replace);
   if (q.size() > 42) q = q.substr(0, 38) + "...\"";
   return q;
-}
-
-// Deepest nesting of arrays and objects, counted before parsing: nlohmann's serialiser and destructor
-// recurse, and a 16 KiB "[[[[..." must not reach them.
-std::size_t nesting_depth(std::string_view text) {
-  std::size_t depth = 0, deepest = 0;
-  bool in_string = false, escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      deepest = std::max(deepest, ++depth);
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return deepest;
 }
 
 bool is_name(const std::string& s) {
@@ -423,12 +399,13 @@ std::variant<Request, ParseError> parse_checked(std::string_view text) {
                                            " bytes is over the limit of " + std::to_string(kMaxMessageBytes) +
                                            " bytes");
   }
-  if (nesting_depth(text) > kMaxDepth) {
-    return refuse(ErrorCode::BadJson, "message: nested deeper than " + std::to_string(kMaxDepth) + " levels");
-  }
   Json message;
   try {
-    message = Json::parse(text.begin(), text.end());
+    // Bounded nesting and no repeated keys (sim/json_text.h): the message is refused before anything
+    // deep is built, and a command never runs with one of two values picked silently.
+    message = parse_json(text);
+  } catch (const JsonShapeError& e) {
+    return refuse(ErrorCode::BadJson, std::string("message: ") + e.what());
   } catch (const Json::exception& e) {
     return refuse(ErrorCode::BadJson, std::string("message: not JSON: ") + e.what());
   }

@@ -8,6 +8,7 @@
 
 #include "server/thread_priority.h"
 #include "sim/error.h"
+#include "sim/json_text.h"
 #include "sim/metrics.h"
 #include "sim/solver.h"
 #include "sim/state_file.h"
@@ -545,7 +546,7 @@ Session::Outcome Session::apply(const protocol::StateLoad& c) {
   Scene scene;
   try {
     st = read_state_file(path);
-    scene = scene_from_json(Json::parse(st.scene_json));
+    scene = scene_from_json(parse_json(st.scene_json));
   } catch (const std::exception& e) {
     return {ErrorCode::Failed, "state '" + c.name + "': " + e.what(), {}};
   }

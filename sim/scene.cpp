@@ -12,6 +12,7 @@
 
 #include "sim/error.h"
 #include "sim/geometry/mesh.h"
+#include "sim/json_text.h"
 
 namespace thaw {
 
@@ -51,10 +52,10 @@ void check_box(const Box& b, const std::string& path, const std::string& what) {
 void check_inside(const Box& domain, const Box& b, const std::string& path) {
   for (int a = 0; a < 3; ++a) {
     if (b.min[a] < domain.min[a] || b.max[a] > domain.max[a]) {
-      throw SceneError(path, std::string("lies outside the domain along ") + kAxis[static_cast<std::size_t>(a)] +
-                                 ": " + format_number(b.min[a]) + " m to " + format_number(b.max[a]) +
-                                 " m, the domain spans " + format_number(domain.min[a]) + " m to " +
-                                 format_number(domain.max[a]) + " m");
+      throw SceneError(
+          path, std::string("lies outside the domain along ") + kAxis[static_cast<std::size_t>(a)] + ": " +
+                    format_number(b.min[a]) + " m to " + format_number(b.max[a]) + " m, the domain spans " +
+                    format_number(domain.min[a]) + " m to " + format_number(domain.max[a]) + " m");
     }
   }
 }
@@ -85,7 +86,6 @@ int material_index(const Json& materials, const Json& name_value, const std::str
   }
   throw SceneError(path, "unknown material '" + name + "'; defined: " + names_of(materials, ""));
 }
-
 
 // Fluid lattices plus boundary particles: enough to stop a spacing typo, not a promise of the count.
 double estimated_particles(const Scene& s, double wall_layers) {
@@ -196,10 +196,11 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   // The lattice sum sum_j dx^3 W is 1.034 for Wendland C2 at H = 2 dx and 1.003 at 3 dx (cubic spline:
   // 0.99997 at 2 dx; tests/sim/sph_kernel_test.cpp): below 3 dx a resting lattice starts compressed.
   if (s.solver.kernel == "wendland_c2" && s.solver.support_ratio < 3.0)
-    throw SceneError("solver.support_ratio",
-                     format_number(s.solver.support_ratio) +
-                         " is too small for the wendland_c2 kernel: use >= 3 (at 2 a resting lattice starts 3.4 % "
-                         "compressed), or the cubic_spline kernel");
+    throw SceneError(
+        "solver.support_ratio",
+        format_number(s.solver.support_ratio) +
+            " is too small for the wendland_c2 kernel: use >= 3 (at 2 a resting lattice starts 3.4 % "
+            "compressed), or the cubic_spline kernel");
 
   const Json& domain = doc["domain"];
   s.domain = box(domain);
@@ -403,7 +404,8 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     if (!s.solver.periodic[static_cast<std::size_t>(a)]) continue;
     const std::string axis(1, kAxis[static_cast<std::size_t>(a)]);
     if (s.solver.flow)
-      throw SceneError("solver.periodic", "periodic axes need solver.flow = false: moving particles do not wrap");
+      throw SceneError("solver.periodic",
+                       "periodic axes need solver.flow = false: moving particles do not wrap");
     for (const std::string& w : s.walls)
       if (w[1] == kAxis[static_cast<std::size_t>(a)])
         throw SceneError("domain.walls", "wall " + w + " on the periodic axis " + axis);
@@ -411,8 +413,8 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     const double support = s.solver.support_ratio * s.spacing;
     if (length < 3.0 * support)
       throw SceneError("solver.periodic", "the domain is " + format_number(length) + " m long along " + axis +
-                                              ", less than 3 kernel supports (" + format_number(3.0 * support) +
-                                              " m)");
+                                              ", less than 3 kernel supports (" +
+                                              format_number(3.0 * support) + " m)");
   }
 
   const double n = estimated_particles(s, wall_layer_count(s));
@@ -478,7 +480,8 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.max_speed = j["max_speed"].get<double>();
   s.output_interval = j["output_interval"].get<double>();
   s.flow = j["flow"].get<bool>();
-  for (const auto& axis : j["periodic"]) s.periodic[static_cast<std::size_t>(axis.get<std::string>()[0] - 'x')] = true;
+  for (const auto& axis : j["periodic"])
+    s.periodic[static_cast<std::size_t>(axis.get<std::string>()[0] - 'x')] = true;
   s.diffusion_number = j["diffusion_number"].get<double>();
   return s;
 }
@@ -496,7 +499,9 @@ void apply_override(Json& doc, const std::string& assignment, const Field& schem
   const std::string text = assignment.substr(eq + 1);
   Json value;
   try {
-    value = Json::parse(text);
+    value = parse_json(text);
+  } catch (const JsonShapeError& e) {
+    throw SceneError(path, "value: " + std::string(e.what()));
   } catch (const Json::parse_error&) {
     value = text;  // solver.kernel=wendland_c2 needs no quotes
   } catch (const Json::out_of_range&) {
@@ -536,7 +541,9 @@ Json read_json_file(const std::string& file) {
   buffer << in.rdbuf();
   const std::string text = buffer.str();
   try {
-    return Json::parse(text, nullptr, true, true);
+    return parse_json(text, true);
+  } catch (const JsonShapeError& e) {
+    throw Error(file + ": " + e.what());
   } catch (const Json::parse_error& e) {
     const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
     throw Error(file + ":" + location(text, offset) + ": invalid JSON: " + parse_reason(e.what()));

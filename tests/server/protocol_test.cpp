@@ -288,10 +288,14 @@ TEST(ProtocolRefuse, NotJsonOrNotAnObject) {
   expect_refused(R"({"type":"sim.speed","factor":1e400})", ErrorCode::BadJson, "message", "JSON");
   expect_refused(R"({"type":"sim.speed","factor":NaN})", ErrorCode::BadJson, "message", "JSON");
   expect_refused(R"({"type":"sim.speed","factor":Infinity})", ErrorCode::BadJson, "message", "JSON");
-  // Deep nesting is refused before the parser sees it.
+  // Deep nesting is refused at the first bracket too deep, before anything deeper is built.
   expect_refused(R"({"type":"param.set","path":"solver.cfl","value":)" + std::string(100, '[') +
                      std::string(100, ']') + "}",
                  ErrorCode::BadJson, "message", "nested");
+  expect_refused(std::string(8000, '[') + std::string(8000, ']'), ErrorCode::BadJson, "message", "nested");
+  // A key given twice is refused, naming it, rather than one of the two values picked silently.
+  expect_refused(R"({"type":"dryer.set","dryer":0,"speed":5,"speed":90})", ErrorCode::BadJson, "message",
+                 "speed: key appears twice");
 }
 
 TEST(ProtocolRefuse, Type) {

@@ -137,17 +137,64 @@ TEST(MeshFile, BrokenFilesAreErrorsNamingThem) {
       "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
       "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
   write_text(dir / "no-face.ply", "ply\nformat ascii 1.0\n" + ply_header + "0 0 0\n1 0 0\n0 1 0\n");
+  write_text(dir / "zero-faces.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+             "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
   write_text(dir / "bad-index.ply",
              "ply\nformat binary_little_endian 1.0\n" + ply_header + std::string(40, '\x01'));
   write_text(dir / "cube.fbx", cube_obj());
-  for (const std::string name : {"short.stl", "garbage.ply", "points.obj", "bad-index.obj", "empty.stl",
-                                 "no-number.stl", "no-face.ply", "bad-index.ply", "cube.fbx"}) {
+  for (const std::string name :
+       {"short.stl", "garbage.ply", "points.obj", "bad-index.obj", "empty.stl", "no-number.stl",
+        "no-face.ply", "zero-faces.ply", "bad-index.ply", "cube.fbx"}) {
     SCOPED_TRACE(name);
     const std::string e = error_of(dir / name);
     EXPECT_EQ(e.rfind(dir / name + ": ", 0), 0u) << e;  // the message starts with the file
   }
-  EXPECT_NE(error_of(dir / "no-face.ply").find("no triangles"), std::string::npos);
+  EXPECT_NE(error_of(dir / "zero-faces.ply").find("no faces"), std::string::npos);
+  // A face announced but not there: refused before Assimp reads it.
+  EXPECT_NE(error_of(dir / "no-face.ply").find("truncated: the PLY header declares 3 vertex, 1 face"),
+            std::string::npos)
+      << error_of(dir / "no-face.ply");
   EXPECT_NE(error_of(dir / "cube.fbx").find("use an OBJ, STL or PLY file"), std::string::npos);
+}
+
+TEST(MeshFile, EveryCutOfAPlyFileIsReadOrRefusedAndNeverHangs) {
+  // A 21-byte "ply\nformat ascii 1.0\n" kept Assimp's PLY reader at 99 % CPU forever. Every prefix of a
+  // valid ASCII and a valid binary PLY file must now load or be refused, each naming the file.
+  TempDir dir("mesh-ply-cuts");
+  const std::string header =
+      "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string ascii =
+      "ply\nformat ascii 1.0\n" + header + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  std::string binary = "ply\nformat binary_little_endian 1.0\n" + header;
+  const float v[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  binary.append(reinterpret_cast<const char*>(v), sizeof v);
+  const std::int32_t faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  for (const auto& f : faces) {
+    binary.push_back('\x03');
+    binary.append(reinterpret_cast<const char*>(f), sizeof f);
+  }
+  int refused = 0, loaded = 0;
+  for (const std::string* whole : std::initializer_list<const std::string*>{&ascii, &binary}) {
+    for (std::size_t n = 0; n <= whole->size(); ++n) {
+      const std::string file = dir / ("cut.ply");
+      write_text(file, whole->substr(0, n));
+      try {
+        const TriangleSoup mesh = load_mesh(file);
+        EXPECT_EQ(mesh.size(), 4u) << n << " bytes";
+        ++loaded;
+      } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()).rfind(file + ": ", 0), 0u) << e.what();
+        ++refused;
+      }
+    }
+  }
+  EXPECT_GE(loaded, 2);  // at least the whole files
+  EXPECT_GT(refused, 300);
+  // The reported file itself.
+  write_text(dir / "21.ply", "ply\nformat ascii 1.0\n");
+  EXPECT_NE(error_of(dir / "21.ply").find("no end_header"), std::string::npos) << error_of(dir / "21.ply");
 }
 
 TEST(MeshFile, UnreadableFileIsAnError) {

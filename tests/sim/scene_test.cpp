@@ -632,6 +632,47 @@ TEST(SceneFile, HugeNumberInAFile) {
   fs::remove(p);
 }
 
+TEST(SceneFile, DeepNestingIsRefusedWithoutOverflowingTheStack) {
+  // 100,000 nested objects crashed `thaw run` (a stack overflow while the document was copied).
+  std::string deep = "{\"name\": \"deep\", \"spacing\": 0.01, \"x\": ";
+  for (int i = 0; i < 100000; ++i) deep += "{\"a\": ";
+  deep += "1" + std::string(100000, '}') + "}";
+  const fs::path p = write_temp("thaw-deep-scene.json", deep);
+  try {
+    load_scene(p.string());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(message(e).find(p.string() + ": x.a.a."), std::string::npos) << message(e).substr(0, 300);
+    EXPECT_NE(message(e).find("nested deeper than 64 levels"), std::string::npos)
+        << message(e).substr(0, 300);
+  }
+  fs::remove(p);
+  // The same limit holds for a --set value.
+  const std::string value = "x=" + std::string(1000, '[') + std::string(1000, ']');
+  EXPECT_NE(message(override_error(value)).find("nested deeper"), std::string::npos);
+}
+
+TEST(SceneFile, ARepeatedKeyIsRefusedNamingItsPath) {
+  const fs::path p =
+      write_temp("thaw-dup-scene.json", "{\"name\": \"d\", \"solver\": {\"cfl\": 0.2, \"cfl\": 0.4}}");
+  try {
+    load_scene(p.string());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(message(e).find(p.string() + ": solver.cfl: key appears twice"), std::string::npos) << e.what();
+  }
+  fs::remove(p);
+  // Inside arrays the path carries the index.
+  const fs::path q = write_temp("thaw-dup-array.json", "{\"fluids\": [{}, {\"box\": 1, \"box\": 2}]}");
+  try {
+    load_scene(q.string());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(message(e).find("fluids[1].box: key appears twice"), std::string::npos) << e.what();
+  }
+  fs::remove(q);
+}
+
 TEST(SceneFile, CommentsAndFileNameAsDefaultName) {
   Json doc = base_scene();
   doc.erase("name");
