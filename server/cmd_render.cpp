@@ -26,6 +26,7 @@ int cmd_render(int argc, char** argv) {
 
   const SimState state = read_state_file(args.positional()[0]);
   const Scene scene = scene_from_json(parse_json(state.scene_json));
+  check_state(state, scene, args.positional()[0]);
   const RenderSnapshot snap =
       make_snapshot(state.particles, temperatures_of(state.particles, scene), scene, state.time, state.step);
 
@@ -36,13 +37,13 @@ int cmd_render(int argc, char** argv) {
     std::istringstream in(*v);
     if (!(in >> px >> comma >> py) || comma != ',' || (in >> rest) || px < 0 || py < 0 || px >= o.width ||
         py >= o.height)
-      throw Error("--pick: expected X,Y inside the " + std::to_string(o.width) + "x" + std::to_string(o.height) +
-                  " image, got '" + *v + "'");
+      throw Error("--pick: expected X,Y inside the " + std::to_string(o.width) + "x" +
+                  std::to_string(o.height) + " image, got '" + *v + "'");
     Eigen::Vector3d hit, normal;
     const DensityFields fields = build_density_fields(snap, o.field);
     if (pick(fields, camera_for(o, snap), px, py, hit, normal))
-      std::printf("pick %g,%g: hit (%.6g, %.6g, %.6g) m, normal (%.4f, %.4f, %.4f)\n", px, py, hit.x(), hit.y(),
-                  hit.z(), normal.x(), normal.y(), normal.z());
+      std::printf("pick %g,%g: hit (%.6g, %.6g, %.6g) m, normal (%.4f, %.4f, %.4f)\n", px, py, hit.x(),
+                  hit.y(), hit.z(), normal.x(), normal.y(), normal.z());
     else
       std::printf("pick %g,%g: no surface\n", px, py);
   }
@@ -50,8 +51,8 @@ int cmd_render(int argc, char** argv) {
   write_png(*out, renderer.render(snap));
   if (!args.flag("--quiet")) {
     const auto& t = renderer.last_times();
-    std::printf("thaw render: %s, t = %.6g s, %dx%d %s view -> %s (", args.positional()[0].c_str(), state.time,
-                o.width, o.height, o.view.c_str(), out->c_str());
+    std::printf("thaw render: %s, t = %.6g s, %dx%d %s view -> %s (", args.positional()[0].c_str(),
+                state.time, o.width, o.height, o.view.c_str(), out->c_str());
     if (o.view == "surface")
       std::printf("field %.1f ms, upload %.1f ms, march %.1f ms, read-back %.1f ms", t.field_ms, t.upload_ms,
                   t.march_ms, t.readback_ms);

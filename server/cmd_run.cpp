@@ -68,6 +68,7 @@ int cmd_run(int argc, char** argv) {
     scene = load_scene(args.positional()[0], args.sets());
     start = initial_state(scene);
   }
+  if (state_in) check_state(start, scene, *state_in);
 
   const double until = args.number("--until", 0.0);
   const long long steps_wanted = args.integer("--steps", 0);

@@ -547,6 +547,7 @@ Session::Outcome Session::apply(const protocol::StateLoad& c) {
   try {
     st = read_state_file(path);
     scene = scene_from_json(parse_json(st.scene_json));
+    check_state(st, scene, c.name);
   } catch (const std::exception& e) {
     return {ErrorCode::Failed, "state '" + c.name + "': " + e.what(), {}};
   }

@@ -30,6 +30,13 @@ std::string format_number(double v) {
 
 // 25000000 -> "25,000,000": particle counts are read by people deciding on a spacing.
 std::string format_count(double v) {
+  // Past a long long (a spacing of 1e-9 m asks for ~1e21 particles): three digits and an exponent.
+  if (!(std::abs(v) < 1e15)) {
+    std::ostringstream s;
+    s.precision(3);
+    s << v;
+    return s.str();
+  }
   std::string digits = std::to_string(static_cast<long long>(std::llround(v)));
   for (int i = static_cast<int>(digits.size()) - 3; i > 0; i -= 3)
     digits.insert(static_cast<std::size_t>(i), ",");

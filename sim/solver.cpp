@@ -191,9 +191,19 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   grid_.reach = kGridReach;
   grid_.origin = lo - Eigen::Vector3f::Constant(grid_.cell);
   const Eigen::Vector3f ext = hi + Eigen::Vector3f::Constant(grid_.cell) - grid_.origin;
-  grid_.nx = static_cast<int>(std::ceil(ext.x() / grid_.cell)) + 1;
-  grid_.ny = static_cast<int>(std::ceil(ext.y() / grid_.cell)) + 1;
-  grid_.nz = static_cast<int>(std::ceil(ext.z() / grid_.cell)) + 1;
+  // Counted in double and checked before any conversion to int: particles far out (or a tiny spacing)
+  // would overflow an int cell count into a negative one that passed the check below.
+  const Eigen::Vector3d count = (ext.cast<double>() / double(grid_.cell)).array().ceil() + 1.0;
+  if (!count.allFinite() || count.prod() > double(1u << 28)) {
+    std::ostringstream needed;
+    needed.precision(3);
+    needed << count.prod();
+    throw SceneError("spacing", "the neighbour grid would need " + needed.str() + " cells (at most " +
+                                    std::to_string(1u << 28) + "); use a smaller domain or a larger spacing");
+  }
+  grid_.nx = static_cast<int>(count.x());
+  grid_.ny = static_cast<int>(count.y());
+  grid_.nz = static_cast<int>(count.z());
   grid_.cells = Eigen::Vector3f::Constant(grid_.cell);
   // A periodic axis is cut into whole cells of at least H between the domain's faces, so the cells
   // around one wrap exactly (the scene guarantees at least three).
@@ -206,9 +216,6 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     grid_.origin[a] = static_cast<float>(scene.domain.min[a]);
   }
   const double cells = double(grid_.nx) * grid_.ny * grid_.nz;
-  if (cells > double(1u << 28))
-    throw SceneError("spacing", "the neighbour grid would need " + std::to_string(cells) +
-                                    " cells; use a smaller domain or a larger spacing");
   ncells_ = static_cast<std::uint32_t>(cells);
   int bits = 1;
   while (bits < 32 && (ncells_ - 1) >> bits) ++bits;

@@ -4,18 +4,22 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 #include <type_traits>
 #include <vector>
 
 #include "sim/error.h"
+#include "sim/scene.h"
 
 namespace thaw {
 namespace {
@@ -486,5 +490,73 @@ void write_state_file(const std::string& path, const SimState& state) {
 }
 
 SimState read_state_file(const std::string& path) { return decode_state(path, read_whole_file(path)); }
+
+void check_state(const SimState& s, const Scene& scene, const std::string& origin) {
+  const auto refuse = [&origin](const std::string& what) { throw Error(origin + ": " + what); };
+  const auto num = [](double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  };
+  if (!std::isfinite(s.time) || s.time < 0) refuse("time " + num(s.time) + " s is not a finite time >= 0");
+  if (!std::isfinite(s.dt) || s.dt < 0) refuse("dt " + num(s.dt) + " s is not a finite time step >= 0");
+
+  Eigen::AlignedBox3d region(scene.domain.min, scene.domain.max);
+  for (const IceBlock& b : scene.ice) region.extend(b.box.min).extend(b.box.max);
+  for (const Solid& b : scene.solids)
+    if (!b.plane) region.extend(b.box.min).extend(b.box.max);
+  const double margin = (wall_layer_count(scene) + 2) * scene.spacing;
+  region.min().array() -= margin;
+  region.max().array() += margin;
+
+  const HostParticles& p = s.particles;
+  const auto where = [&p](const char* section, std::size_t i) {
+    return std::string("section '") + section + "', particle " + std::to_string(i) +
+           (i < p.id.size() ? " (id " + std::to_string(p.id[i]) + ")" : "") + ": ";
+  };
+  const auto finite4 = [](const Float4& v, int n) {
+    for (int k = 0; k < n; ++k)
+      if (!std::isfinite(v[std::size_t(k)])) return false;
+    return true;
+  };
+  const auto vec = [&num](const Float4& v) {
+    return "(" + num(v[0]) + ", " + num(v[1]) + ", " + num(v[2]) + ")";
+  };
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Float4& x = p.position[i];
+    if (!finite4(x, 3)) refuse(where("position", i) + vec(x) + " is not finite");
+    if (!region.contains(Eigen::Vector3d(x[0], x[1], x[2])))
+      refuse(where("position", i) + vec(x) +
+             " m lies outside the region this scene's particles can occupy, " + "from " +
+             vec({float(region.min().x()), float(region.min().y()), float(region.min().z()), 0}) + " to " +
+             vec({float(region.max().x()), float(region.max().y()), float(region.max().z()), 0}) + " m");
+    if (!std::isfinite(x[3]) || !(x[3] > 0))
+      refuse(where("position", i) + "mass " + num(x[3]) + " kg is not finite and positive");
+    if (!finite4(p.velocity[i], 3)) refuse(where("velocity", i) + vec(p.velocity[i]) + " is not finite");
+    if (!std::isfinite(p.density[i]) || p.density[i] < 0)
+      refuse(where("density", i) + num(p.density[i]) + " kg/m^3 is not finite and >= 0");
+    if (p.phase[i] >= kPhaseCount)
+      refuse(where("phase", i) + std::to_string(p.phase[i]) + " is not a phase (0.." +
+             std::to_string(kPhaseCount - 1) + ")");
+    if (p.material[i] >= scene.materials.size())
+      refuse(where("material", i) + "material " + std::to_string(p.material[i]) +
+             " does not exist; the scene has " + std::to_string(scene.materials.size()));
+    if (!std::isfinite(p.enthalpy[i][0]) || !std::isfinite(p.enthalpy[i][1]))
+      refuse(where("enthalpy", i) + num(p.enthalpy[i][0]) + " + " + num(p.enthalpy[i][1]) +
+             " J/kg is not finite");
+    if (i < p.anchored.size() && p.anchored[i] > 1)
+      refuse(where("anchored", i) + std::to_string(p.anchored[i]) + " is neither 0 nor 1");
+  }
+  for (std::size_t i = 0; i < s.rigid_offset.size(); ++i)
+    if (!finite4(s.rigid_offset[i], 4)) refuse(where("body_offset", i) + "not finite");
+  const auto all_finite = [&](const std::vector<double>& v, const char* section) {
+    for (std::size_t k = 0; k < v.size(); ++k)
+      if (!std::isfinite(v[k]))
+        refuse(std::string("section '") + section + "', entry " + std::to_string(k) + ": not finite");
+  };
+  all_finite(s.energy_budget, "energy_budget");
+  all_finite(s.rigid_bodies, "rigid_bodies");
+  all_finite(s.rigid_labelling, "rigid_labelling");
+}
 
 }  // namespace thaw

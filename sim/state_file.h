@@ -69,6 +69,17 @@ void write_state_file(const std::string& path, const SimState& state);
 // every failure is a thaw::Error naming the file and what was wrong.
 SimState read_state_file(const std::string& path);
 
+// Checks what a state file holds against the scene it will run: the time finite and not negative, the
+// time step finite and not negative, and for every particle a finite position inside the region the
+// scene's particles can occupy (its domain, solids and ice, grown by the wall layers and two spacings),
+// a finite positive mass, a finite velocity, density and enthalpy, a known phase, a material the scene
+// has, and the rigid ice records finite. A checksum proves the file is what was written, not that it
+// is sane: a hand-made or buggy file must be refused here, before a kernel meets it (positions at 1e9
+// overflowed the neighbour grid's cell count and crashed inside the OpenCL driver). Throws Error
+// naming `origin` (the file), the section and the particle.
+struct Scene;
+void check_state(const SimState& state, const Scene& scene, const std::string& origin);
+
 // FNV-1a, 64 bit. Any single changed byte always changes the sum: each step is a bijection of the
 // running hash for a fixed input byte.
 std::uint64_t fnv1a64(std::string_view bytes, std::uint64_t hash = 0xcbf29ce484222325ull);

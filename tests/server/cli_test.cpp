@@ -5,11 +5,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "sim/scene.h"
+#include "sim/state_file.h"
 #include "tests/test_support.h"
 
 namespace thaw {
@@ -243,13 +245,65 @@ TEST(ThawCli, HeatRunReportsTheEnergyBudgetAndExportsTemperature) {
 
   // Resuming carries the enthalpy and the energy account: 30 + 30 steps equal 60 straight.
   const auto straight = run_thaw(
-      "run ice-on-plate --steps 60 --set spacing=0.006 --set solver.output_interval=0.005 --state-out full.state "
+      "run ice-on-plate --steps 60 --set spacing=0.006 --set solver.output_interval=0.005 --state-out "
+      "full.state "
       "--no-progress --quiet",
       dir);
   ASSERT_TRUE(straight.exited && straight.exit_code == 0) << describe(straight);
-  const auto resumed = run_thaw("run --state-in half.state --steps 30 --state-out resumed.state --no-progress --quiet", dir);
+  const auto resumed =
+      run_thaw("run --state-in half.state --steps 30 --state-out resumed.state --no-progress --quiet", dir);
   ASSERT_TRUE(resumed.exited && resumed.exit_code == 0) << describe(resumed);
-  EXPECT_TRUE(testing::read_file_bytes(dir / "full.state") == testing::read_file_bytes(dir / "resumed.state"));
+  EXPECT_TRUE(testing::read_file_bytes(dir / "full.state") ==
+              testing::read_file_bytes(dir / "resumed.state"));
+}
+
+// A state file whose checksums are valid but whose contents are not: each field is refused by name
+// before any kernel sees it (positions at 1e9 crashed `thaw run --state-in` inside the OpenCL driver;
+// NaN positions, a NaN time, a negative dt and an unknown material were taken silently).
+TEST(ThawCli, StateFilesWithImpossibleValuesAreRefusedNamingTheField) {
+  TempDir dir("cli-bad-state");
+  const auto made = run_thaw(
+      "run ice-on-plate --steps 2 --set spacing=0.006 --state-out s.state --no-progress --quiet", dir);
+  ASSERT_TRUE(made.exited && made.exit_code == 0) << describe(made);
+  const SimState good = read_state_file(dir / "s.state");
+  ASSERT_GT(good.particles.size(), 10u);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  struct Case {
+    const char* name;
+    void (*spoil)(SimState&, float, float);
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"far", [](SimState& s, float, float) { s.particles.position[7][0] = 1e9f; },
+       "section 'position', particle 7"},
+      {"inf", [](SimState& s, float i, float) { s.particles.position[3][2] = i; },
+       "section 'position', particle 3"},
+      {"nan", [](SimState& s, float, float n) { s.particles.position[4][1] = n; },
+       "section 'position', particle 4"},
+      {"time", [](SimState& s, float, float n) { s.time = double(n); }, "time nan s"},
+      {"dt", [](SimState& s, float, float) { s.dt = -1e-4; }, "dt -0.0001 s"},
+      {"material", [](SimState& s, float, float) { s.particles.material[9] = 200; },
+       "section 'material', particle 9"},
+      {"velocity", [](SimState& s, float i, float) { s.particles.velocity[2][0] = i; },
+       "section 'velocity', particle 2"},
+      {"mass", [](SimState& s, float, float) { s.particles.position[1][3] = 0; }, "mass 0 kg"},
+      {"enthalpy", [](SimState& s, float, float n) { s.particles.enthalpy[6][0] = n; },
+       "section 'enthalpy', particle 6"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    SimState bad = good;
+    c.spoil(bad, inf, nan);
+    const std::string file = std::string(c.name) + ".state";
+    write_state_file(dir / file, bad);
+    const auto r = run_thaw("run --state-in " + file + " --steps 3 --no-progress --quiet", dir);
+    EXPECT_TRUE(r.exited && r.exit_code != 0) << describe(r);
+    EXPECT_NE(r.err.find(file + ": "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+    const auto v = run_thaw("render " + file + " --out x.png --size 64x48", dir);
+    EXPECT_TRUE(v.exited && v.exit_code != 0) << describe(v);
+    EXPECT_NE(v.err.find(c.expected), std::string::npos) << v.err;
+  }
 }
 
 // Off-screen output from the command line: PNG frames and meshes during a run, any view of a state
@@ -278,10 +332,11 @@ TEST(ThawCli, FramesMeshesAndRenderedStates) {
   const auto picked = run_thaw("render s.state --out p.png --size 160x120 --pick 80,60", dir);
   ASSERT_TRUE(picked.exited && picked.exit_code == 0) << describe(picked);
   EXPECT_NE(picked.out.find("pick 80,60: hit ("), std::string::npos) << picked.out;
-  const auto corner = run_thaw("render s.state --out p.png --size 160x120 --pick 0,0 --target 0.06,0.06,0.5", dir);
+  const auto corner =
+      run_thaw("render s.state --out p.png --size 160x120 --pick 0,0 --target 0.06,0.06,0.5", dir);
   EXPECT_NE(corner.out.find("no surface"), std::string::npos) << corner.out;
-  for (const char* bad : {"--view wireframe", "--size 10x10", "--camera 30", "--slice w,0.5", "--colour-by speed",
-                          "--target 1,2", "--fov 200", "--pick 700,1"}) {
+  for (const char* bad : {"--view wireframe", "--size 10x10", "--camera 30", "--slice w,0.5",
+                          "--colour-by speed", "--target 1,2", "--fov 200", "--pick 700,1"}) {
     const auto b = run_thaw(std::string("render s.state --out b.png ") + bad, dir);
     ASSERT_TRUE(b.exited) << bad;
     EXPECT_EQ(b.exit_code, 2) << bad;
@@ -291,7 +346,8 @@ TEST(ThawCli, FramesMeshesAndRenderedStates) {
   const auto missing = run_thaw("render nowhere.state --out b.png", dir);
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("nowhere.state"), std::string::npos) << missing.err;
-  const auto fmt = run_thaw("run ice-on-plate --steps 1 --set spacing=0.006 --export-mesh m --mesh-format stl", dir);
+  const auto fmt =
+      run_thaw("run ice-on-plate --steps 1 --set spacing=0.006 --export-mesh m --mesh-format stl", dir);
   EXPECT_EQ(fmt.exit_code, 2);
   EXPECT_NE(fmt.err.find("stl"), std::string::npos) << fmt.err;
 }

@@ -207,6 +207,16 @@ TEST_F(SessionTest, StateSaveAndLoadRoundTripInsideTheStateFolder) {
   EXPECT_EQ(broken.code, ErrorCode::Failed);
   EXPECT_EQ((*s->latest_stats())["steps"], saved.result["steps"]);
 
+  // A file with valid checksums and a particle far away crashed the service inside a kernel; it is now
+  // refused before the solver is built, naming the section and the particle.
+  SimState far = read_state_file((dir_.path() / "states" / "snap_1.state").string());
+  far.particles.position[5][0] = 1e9f;
+  write_state_file((dir_.path() / "states" / "far.state").string(), far);
+  Reply refused = call(*s, protocol::StateLoad{"far"});
+  EXPECT_EQ(refused.code, ErrorCode::Failed);
+  EXPECT_NE(refused.message.find("section 'position', particle 5"), std::string::npos) << refused.message;
+  EXPECT_EQ((*s->latest_stats())["steps"], saved.result["steps"]);
+
   // save_state() for shutdown, while the thread runs and after it stopped.
   s->save_state(dir_ / "running.state");
   s->stop();
@@ -390,7 +400,7 @@ TEST(ThreadPriority, LoweredForThisThreadAndInheritedByItsThreads) {
   }).join();
   if (!ok) GTEST_SKIP() << "this system refuses to change a thread's nice value";
   EXPECT_EQ(lowered, std::min(before + 3, 19));
-  EXPECT_EQ(child, lowered);           // e.g. an OpenCL CPU driver's workers started from that thread
+  EXPECT_EQ(child, lowered);              // e.g. an OpenCL CPU driver's workers started from that thread
   EXPECT_EQ(this_thread_nice(), before);  // the other threads keep theirs
 }
 
