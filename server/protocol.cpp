@@ -86,9 +86,12 @@ std::string checked_name(const Json& v, const std::string& field) {
 Eigen::Vector3d vec(const Json& v) { return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()}; }
 
 // Directions and normals are normalised by the simulation; a zero vector has no direction.
+// The scene's own rule (unit_direction), so a client and a scene file are refused alike.
 Eigen::Vector3d nonzero_vec(const Json& v, const std::string& field, const std::string& what = "") {
   const Eigen::Vector3d d = vec(v);
-  if (d.squaredNorm() == 0.0 || !std::isfinite(d.squaredNorm())) {
+  try {
+    unit_direction(d, field);
+  } catch (const SceneError&) {
     throw FieldError{field, what + "must be a non-zero vector of moderate size, got " + v.dump()};
   }
   return d;
@@ -318,9 +321,12 @@ std::vector<Spec> build_specs() {
                               {integer("n", "Steps to take, then pause").def(1).at_least(1).at_most(10000)},
                               read_sim_step));
   rows.push_back(row<SimReset>("sim.reset", {}));
-  rows.push_back(row<SimSpeed>(
-      "sim.speed", {number("factor", "Simulated time per wall-clock time").above(0).at_most(1000)},
-      read_sim_speed));
+  rows.push_back(
+      row<SimSpeed>("sim.speed",
+                    {number("factor", "Simulated time per wall-clock time; 0.001 is a millisecond a second")
+                         .at_least(1e-3)
+                         .at_most(1000)},
+                    read_sim_speed));
   rows.push_back(
       row<SceneLoad>("scene.load", {text("name", "A scene in configs/, without .json")}, read_scene_load));
   rows.push_back(row<ParamSet>("param.set", {text("path", "A client-settable scene field, e.g. solver.cfl")},

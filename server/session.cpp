@@ -62,6 +62,37 @@ bool valid_state_name(const std::string& name) {
   });
 }
 
+// The first array index in a parameter path ("dryers[5].speed") past the end of its array in `doc`, as
+// "dryers[5] does not exist; the scene has 1": the protocol's not_found, not a bad field.
+std::optional<std::string> missing_element(const Json& doc, const std::string& path) {
+  const Json* node = &doc;
+  std::size_t at = 0;
+  std::string walked;
+  while (at < path.size() && node != nullptr) {
+    if (path[at] == '[') {
+      const std::size_t close = path.find(']', at);
+      if (close == std::string::npos || !node->is_array()) return std::nullopt;
+      const std::string digits = path.substr(at + 1, close - at - 1);
+      if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+        return std::nullopt;
+      const std::size_t index = std::stoul(digits);
+      walked += path.substr(at, close + 1 - at);
+      if (index >= node->size())
+        return walked + " does not exist; the scene has " + std::to_string(node->size());
+      node = &(*node)[index];
+      at = close + 1;
+    } else {
+      if (path[at] == '.') ++at;
+      const std::size_t end = path.find_first_of(".[", at);
+      const std::string key = path.substr(at, end == std::string::npos ? std::string::npos : end - at);
+      walked += (walked.empty() ? "" : ".") + key;
+      node = node->is_object() && node->contains(key) ? &(*node)[key] : nullptr;
+      at = end == std::string::npos ? path.size() : end;
+    }
+  }
+  return std::nullopt;
+}
+
 // Completions run on the simulation thread; one that throws must not take the thread down with it.
 void answer(const Session::Done& done, std::optional<ErrorCode> code, const std::string& message,
             const Json& result) {
@@ -245,9 +276,12 @@ void Session::run() {
       if (speed_ > 0) {
         // Never run ahead of wall time * factor; when behind by more than a moment, start counting afresh
         // rather than sprint to catch up.
+        // In double and bounded before it becomes a duration: a tiny factor made this overflow the
+        // clock's integer ticks into the past, and the run went flat out.
+        const double ahead_s = std::clamp((solver_->time() - anchor_sim_) / speed_, 0.0, 3600.0);
         const auto due =
             anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
-                               std::chrono::duration<double>((solver_->time() - anchor_sim_) / speed_));
+                               std::chrono::duration<double>(std::isfinite(ahead_s) ? ahead_s : 0.0));
         const auto now = Clock::now();
         if (now < due) {
           if (dirty_) maybe_publish();
@@ -369,9 +403,9 @@ Session::Outcome Session::apply(const protocol::Command& command, Done& done, bo
             return Outcome{std::nullopt, "", time_result()};
           },
           [&](const protocol::SimSpeed& c) {
-            if (!std::isfinite(c.factor) || c.factor < 0 || c.factor > 1000)
+            if (!std::isfinite(c.factor) || !(c.factor == 0 || (c.factor >= 1e-3 && c.factor <= 1000)))
               return Outcome{
-                  ErrorCode::BadField, "factor: must be in (0, 1000], or 0 for as fast as possible", {}};
+                  ErrorCode::BadField, "factor: must be in [0.001, 1000], or 0 for as fast as possible", {}};
             speed_ = c.factor;
             reanchor();
             dirty_ = true;
@@ -506,6 +540,7 @@ Session::Outcome Session::apply(const protocol::ParamSet& c) {
   const Field* field = find_field(scene_schema(), c.path);
   if (!field || !field->settable)
     return {ErrorCode::BadField, "path: '" + c.path + "' is not a parameter a client may change", {}};
+  if (const auto missing = missing_element(scene_.source, c.path)) return {ErrorCode::NotFound, *missing, {}};
   Scene scene;
   try {
     Json doc = scene_.source;

@@ -357,8 +357,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
       solid.plane = true;
       solid.point = vec(j["point"]);
       solid.normal = vec(j["normal"]);
-      if (solid.normal.norm() == 0.0) throw SceneError(path + ".normal", "must not be zero");
-      solid.normal.normalize();
+      solid.normal = unit_direction(solid.normal, path + ".normal");
     }
     solid.temperature = temperature_of(j, ambient);
     if (j["hold_temperature"].get<bool>()) {
@@ -381,8 +380,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     lamp.on = j["on"].get<bool>();
     lamp.centre = vec(j["centre"]);
     lamp.normal = vec(j["normal"]);
-    if (lamp.normal.norm() == 0.0) throw SceneError(path + ".normal", "must not be zero");
-    lamp.normal.normalize();
+    lamp.normal = unit_direction(lamp.normal, path + ".normal");
     lamp.width = j["width"].get<double>();
     lamp.height = j["height"].get<double>();
     lamp.temperature = j["temperature"].get<double>();
@@ -397,8 +395,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     d.on = j["on"].get<bool>();
     d.position = vec(j["position"]);
     d.direction = vec(j["direction"]);
-    if (d.direction.norm() == 0.0) throw SceneError(path + ".direction", "must not be zero");
-    d.direction.normalize();
+    d.direction = unit_direction(d.direction, path + ".direction");
     d.half_angle = j["half_angle"].get<double>();
     d.reach = j["reach"].get<double>();
     d.temperature = j["temperature"].get<double>();
@@ -456,6 +453,14 @@ std::string parse_reason(const std::string& what) {
 }
 
 }  // namespace
+
+Eigen::Vector3d unit_direction(const Eigen::Vector3d& v, const std::string& path) {
+  const double squared = v.squaredNorm();
+  if (!std::isfinite(squared) || !(squared > 0))
+    throw SceneError(path, "must be a non-zero vector of moderate size, got [" + format_number(v.x()) + ", " +
+                               format_number(v.y()) + ", " + format_number(v.z()) + "]");
+  return v / std::sqrt(squared);
+}
 
 int wall_layer_count(const Scene& s) {
   if (s.wall_layers > 0) return s.wall_layers;

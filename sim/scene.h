@@ -117,7 +117,7 @@ struct SolverSettings {
   double output_interval = 0.01;            // [s] metrics / export cadence in sim time
   bool flow = true;                         // false: particles stay put, only heat flows
   std::array<bool, 3> periodic = {false, false, false};  // axes the domain wraps around (flow = false)
-  double diffusion_number = 0.1;            // dt <= diffusion_number * h^2 / (time_scale * alpha_max)
+  double diffusion_number = 0.1;  // dt <= diffusion_number * h^2 / (time_scale * alpha_max)
 };
 
 struct Scene {
@@ -139,6 +139,11 @@ struct Scene {
   std::vector<Dryer> dryers;
   Json source;  // the validated document with every default filled in
 };
+
+// `v` scaled to unit length; `path` names it in the SceneError when it is not a vector of moderate size:
+// zero, or so long or so short that its squared length overflows or underflows a double. The protocol
+// refuses the same vectors: [1e308, 1e308, 1e308] normalised to zeros, and the dryer delivered 0 J.
+Eigen::Vector3d unit_direction(const Eigen::Vector3d& v, const std::string& path);
 
 // Layers of particles in the domain walls and sampled solids: domain.wall_layers, or as many as hold water
 // resting on them: one more than the support ratio above 2 spacings (4 at 3), else the ratio rounded up.

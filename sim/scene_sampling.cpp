@@ -95,9 +95,9 @@ HostParticles sample_scene(const Scene& scene) {
   }
   // Domain walls: lattice points outside the domain, within the layer depth, on walled sides only.
   if (!scene.walls.empty()) {
-    const double h_wall = enthalpy_at(scene, scene.wall_material, scene.heat.wall_coefficient > 0
-                                                                      ? scene.heat.wall_temperature
-                                                                      : scene.heat.ambient_temperature);
+    const double h_wall = enthalpy_at(
+        scene, scene.wall_material,
+        scene.heat.wall_coefficient > 0 ? scene.heat.wall_temperature : scene.heat.ambient_temperature);
     const auto& d = scene.domain;
     auto walled = [&](int axis, bool upper) {
       const std::string side = std::string(upper ? "+" : "-") + "xyz"[axis];
@@ -124,9 +124,20 @@ HostParticles sample_scene(const Scene& scene) {
     const auto& c = scene.ice[b];
     const double h = enthalpy_at(scene, c.material, c.temperature);
     std::vector<Vec3> points = voxelize(c.shape, dx, &scene.domain.min);
+    // Ice that became no particles is a scene mistake, not a melt that ends at once: a one-triangle mesh
+    // ran a scene with no ice, exit 0 and no word.
+    const std::string path = "ice[" + std::to_string(b) + "]";
+    if (points.empty())
+      throw SceneError(path, "its shape holds no particle at a spacing of " + std::to_string(dx * 1e3) +
+                                 " mm: a mesh must be closed around a volume (an open or flat one encloses "
+                                 "none), and a shape must be wider than one spacing");
     drop_outside(points, scene.domain);
     for (const auto& s : scene.solids) drop_inside(points, s);
     for (std::size_t e = 0; e < b; ++e) drop_inside(points, scene.ice[e].shape);
+    if (points.empty())
+      throw SceneError(path,
+                       "every particle of its shape lies outside the domain, inside a solid or inside "
+                       "earlier ice");
     const bool anchored = c.motion == IceBlock::Motion::Fixed;
     for (const Vec3& x : points) add(p, x, Vec3::Zero(), boundary_mass, Phase::Ice, c.material, h, anchored);
   }

@@ -75,7 +75,8 @@ const Field& solver_schema() {
               .above(0)
               .client_settable(),
           flag("flow",
-               "Move the fluid (density, forces, integration); false = particles stay where they are and only heat "
+               "Move the fluid (density, forces, integration); false = particles stay where they are and "
+               "only heat "
                "flows, at the diffusion time step (conduction studies, the Stefan problem)")
               .def(true),
           subset("periodic", {"x", "y", "z"},
@@ -184,7 +185,8 @@ const Field& scene_schema() {
               "domain",
               {
                   vec3("min", "Lower corner").in("m"),
-                  vec3("max", "Upper corner; above min on every axis, and a whole number of spacings from it "
+                  vec3("max",
+                       "Upper corner; above min on every axis, and a whole number of spacings from it "
                        "along an axis with a wall on its upper side")
                       .in("m"),
                   subset("walls", {"-x", "+x", "-y", "+y", "-z", "+z"},
@@ -267,10 +269,17 @@ const Field& scene_schema() {
                   choice("kind", {"fluid", "solid", "ice"},
                          "Fluid particles move; solids are static boundaries; ice stays in place and melts "
                          "into its melts_into fluid"),
-                  number("density", "Rest density").in("kg/m^3").above(0).at_most(1e5),
+                  number("density",
+                         "Rest density; 0.01 is below any real gas (1e-300 gave particles no mass)")
+                      .in("kg/m^3")
+                      .at_least(0.01)
+                      .at_most(1e5),
                   number("viscosity", "Dynamic viscosity (fluids)").in("Pa s").def(0.0).at_least(0),
                   number("conductivity", "Thermal conductivity k").in("W/m/K").at_least(0).at_most(1e4),
-                  number("specific_heat", "Specific heat capacity c").in("J/kg/K").above(0).at_most(1e6),
+                  number("specific_heat", "Specific heat capacity c; real materials have 100 or more")
+                      .in("J/kg/K")
+                      .at_least(1)
+                      .at_most(1e6),
                   text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
                       .when("kind", "ice"),
                   number("latent_heat", "Latent heat of fusion L")

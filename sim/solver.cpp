@@ -776,9 +776,8 @@ void Solver::set_dryer(std::size_t index, const Dryer& d) {
             {"speed", d.speed},
             {"nozzle_diameter", d.nozzle_diameter}};
   validate(j, *find_field(scene_schema(), "dryers[0]"), path);
-  if (d.direction.norm() == 0.0) throw SceneError(path + ".direction", "must not be zero");
   Dryer checked = d;
-  checked.direction.normalize();
+  checked.direction = unit_direction(d.direction, path + ".direction");
   scene_.dryers[index] = checked;
   dryers_dirty_ = true;
 }
@@ -797,9 +796,8 @@ void Solver::set_lamp(std::size_t index, const Lamp& l) {
             {"emissivity", l.emissivity},
             {"photons", l.photons}};
   validate(j, *find_field(scene_schema(), "lamps[0]"), path);
-  if (l.normal.norm() == 0.0) throw SceneError(path + ".normal", "must not be zero");
   Lamp checked = l;
-  checked.normal.normalize();
+  checked.normal = unit_direction(l.normal, path + ".normal");
   scene_.lamps[index] = checked;
 }
 

@@ -293,6 +293,8 @@ TEST(ProtocolRefuse, NotJsonOrNotAnObject) {
                      std::string(100, ']') + "}",
                  ErrorCode::BadJson, "message", "nested");
   expect_refused(std::string(8000, '[') + std::string(8000, ']'), ErrorCode::BadJson, "message", "nested");
+  // A pace so slow it overflowed the session's clock arithmetic.
+  expect_refused(R"({"type":"sim.speed","factor":1e-300})", ErrorCode::BadField, "sim.speed", "factor");
   // A key given twice is refused, naming it, rather than one of the two values picked silently.
   expect_refused(R"({"type":"dryer.set","dryer":0,"speed":5,"speed":90})", ErrorCode::BadJson, "message",
                  "speed: key appears twice");

@@ -259,6 +259,11 @@ TEST_F(SessionTest, ParamSetTakesEffectAndKeepsTheParticles) {
   EXPECT_EQ(call(*s, protocol::ParamSet{"heat.time_scale", -1}).code, ErrorCode::BadField);
   EXPECT_EQ(call(*s, protocol::ParamSet{"spacing", 0.01}).code, ErrorCode::BadField);  // not live
   EXPECT_EQ(s->scene()->heat.time_scale, 50.0);
+  // An index past the scene's array is not_found, as PROTOCOL.md says (it was bad_field).
+  const Reply missing = call(*s, protocol::ParamSet{"dryers[5].speed", 5});
+  EXPECT_EQ(missing.code, ErrorCode::NotFound) << missing.message;
+  EXPECT_NE(missing.message.find("dryers[5] does not exist; the scene has"), std::string::npos)
+      << missing.message;
   ASSERT_FALSE(call(*s, protocol::SimStep{2}).code);
 }
 

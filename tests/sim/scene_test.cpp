@@ -546,6 +546,61 @@ TEST(SceneError, BrokenMeshNamesTheFieldAndTheFile) {
   EXPECT_NE(message(e).find(file), std::string::npos) << e.what();
 }
 
+TEST(SceneError, IceThatBecomesNoParticlesIsRefused) {
+  // A one-triangle OBJ or STL as ice ran a scene without ice, exit 0 and no word.
+  testing::TempDir dir("scene-flat-mesh");
+  testing::write_text(dir.path() / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  testing::write_text(dir.path() / "tri.stl",
+                      "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                      "endloop\nendfacet\nendsolid t\n");
+  for (const char* name : {"tri.obj", "tri.stl"}) {
+    SCOPED_TRACE(name);
+    const Scene s =
+        scene_from_json(scene_with_ice(R"([{"material": "ice", "shape": "mesh", "mesh": ")" + (dir / name) +
+                                       R"(", "centre": [0.05, 0.05, 0.2], "size": 0.04}])"));
+    try {
+      initial_state(s);
+      ADD_FAILURE() << "no error";
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.path(), "ice[0]");
+      EXPECT_NE(message(e).find("closed around a volume"), std::string::npos) << e.what();
+    }
+  }
+  // Ice placed wholly inside earlier ice.
+  const Scene inside = scene_from_json(scene_with_ice(
+      R"([{"material": "ice", "shape": "sphere", "centre": [0.05, 0.05, 0.2], "radius": 0.03},
+          {"material": "ice", "shape": "sphere", "centre": [0.05, 0.05, 0.2], "radius": 0.01}])"));
+  try {
+    initial_state(inside);
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path(), "ice[1]");
+    EXPECT_NE(message(e).find("inside earlier ice"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneError, ImpossibleMagnitudesNameTheirField) {
+  // A rest density of 1e-300 gave particles no mass and failed as "particle 0 has mass -nan".
+  const SceneError density = override_error("materials.water.density=1e-300");
+  EXPECT_EQ(density.path(), "materials.water.density");
+  // A spacing of 1e-9 m was "about -9,223,372,036,854,775,808 particles".
+  const SceneError tiny = override_error("spacing=1e-9");
+  EXPECT_EQ(tiny.path(), "spacing");
+  EXPECT_EQ(message(tiny).find("-9,223"), std::string::npos) << tiny.what();
+  EXPECT_NE(message(tiny).find("e+"), std::string::npos) << tiny.what();
+  // A dryer direction of [1e308, 1e308, 1e308] normalised to zeros and delivered 0 J; the protocol
+  // refused it. A scene file now refuses it as the protocol does, and so are the tiny ones.
+  Json doc = base_scene();
+  doc["dryers"] = Json::parse(R"([{"position": [0.1, 0.1, 0.25], "direction": [1e308, 1e308, 1e308]}])");
+  const SceneError huge = scene_error(doc);
+  EXPECT_EQ(huge.path(), "dryers[0].direction");
+  EXPECT_NE(message(huge).find("moderate size"), std::string::npos) << huge.what();
+  doc["dryers"][0]["direction"] = Json::parse("[1e-320, 0, 0]");
+  EXPECT_EQ(scene_error(doc).path(), "dryers[0].direction");
+  doc["dryers"][0]["direction"] = Json::parse("[0, 1e150, 1e150]");
+  EXPECT_NEAR(scene_from_json(doc).dryers[0].direction.y(), std::sqrt(0.5), 1e-12);
+}
+
 TEST(SceneError, ShapeFieldsAreCheckedAtTheirPaths) {
   struct Case {
     const char* ice;
