@@ -18,7 +18,8 @@ Json scene_names() {
   Json names = Json::array();
   std::error_code ec;
   std::vector<std::string> found;
-  for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(THAW_SOURCE_DIR) / "configs", ec))
+  for (const auto& e :
+       std::filesystem::directory_iterator(std::filesystem::path(THAW_SOURCE_DIR) / "configs", ec))
     if (e.path().extension() == ".json") found.push_back(e.path().stem().string());
   std::sort(found.begin(), found.end());
   for (const auto& n : found) names.push_back(n);
@@ -57,7 +58,8 @@ Json Service::welcome(bool controller) const {
   const auto scene = session_.scene();
   Json lamps = Json::array();
   for (const Lamp& l : scene->lamps)
-    lamps.push_back({{"on", l.on}, {"centre", vec(l.centre)}, {"normal", vec(l.normal)}, {"temperature", l.temperature}});
+    lamps.push_back(
+        {{"on", l.on}, {"centre", vec(l.centre)}, {"normal", vec(l.normal)}, {"temperature", l.temperature}});
   return {{"type", "welcome"},
           {"protocol", protocol::kVersion},
           {"scene", scene->name},
@@ -97,6 +99,12 @@ void Service::on_oversize(std::uint64_t client, std::size_t bytes) {
                                     std::to_string(protocol::kMaxMessageBytes)));
 }
 
+void Service::on_binary(std::uint64_t client, std::size_t bytes) {
+  reply(client, protocol::error(protocol::ErrorCode::BadJson, "message: a binary message of " +
+                                                                  std::to_string(bytes) +
+                                                                  " bytes; commands are JSON text messages"));
+}
+
 void Service::on_text(std::uint64_t client, std::string_view message) {
   using namespace protocol;
   bool controller = false;
@@ -122,9 +130,10 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
         id = std::get<ParseError>(parsed).id;
         type = std::get<ParseError>(parsed).type;
       }
-      reply(client, error(ErrorCode::RateLimited,
-                          "more than " + std::to_string(int(options_.command_rate)) + " commands a second; slow down",
-                          id, type));
+      reply(client,
+            error(ErrorCode::RateLimited,
+                  "more than " + std::to_string(int(options_.command_rate)) + " commands a second; slow down",
+                  id, type));
       return;
     }
     controller = it->second.controller;
@@ -147,8 +156,8 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
     return;
   }
   if (needs_controller(r.command) && !controller) {
-    reply(client, error(ErrorCode::Forbidden, type + ": needs the controller role (hello with the server's token)",
-                        r.id, type));
+    reply(client, error(ErrorCode::Forbidden,
+                        type + ": needs the controller role (hello with the server's token)", r.id, type));
     return;
   }
   const auto id = r.id;
@@ -190,8 +199,8 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
         } else if constexpr (std::is_same_v<T, DryerAim>) {
           const auto hit = renderer_.pick(c.x, c.y);
           if (!hit)
-            done(ErrorCode::NotFound, type + ": no surface under pixel (" + std::to_string(c.x) + ", " +
-                                          std::to_string(c.y) + ")",
+            done(ErrorCode::NotFound,
+                 type + ": no surface under pixel (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ")",
                  Json::object());
           else
             session_.aim_dryer(c.dryer, hit->hit, done);

@@ -18,11 +18,11 @@
 namespace thaw {
 
 struct ServiceOptions {
-  std::string token;          // empty: no token; then only a loopback server gives clients control
-  bool loopback = true;       // the server listens on 127.0.0.1 only
-  double command_rate = 50;   // commands a second per client, on average
+  std::string token;         // empty: no token; then only a loopback server gives clients control
+  bool loopback = true;      // the server listens on 127.0.0.1 only
+  double command_rate = 50;  // commands a second per client, on average
   double command_burst = 100;
-  double stats_rate = 10;     // stats events a second at most
+  double stats_rate = 10;  // stats events a second at most
 };
 
 class Service : public WsHandler {
@@ -35,6 +35,7 @@ class Service : public WsHandler {
   void on_open(std::uint64_t client, const std::string& peer_address) override;
   void on_text(std::uint64_t client, std::string_view message) override;
   void on_oversize(std::uint64_t client, std::size_t bytes) override;
+  void on_binary(std::uint64_t client, std::size_t bytes) override;
   void on_close(std::uint64_t client) override;
 
   // The welcome event a client gets in answer to hello (also for tests and `thaw ctl`).

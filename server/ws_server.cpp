@@ -19,11 +19,11 @@ namespace {
 
 struct Client {
   lws* wsi = nullptr;
-  std::deque<std::string> texts;          // JSON events waiting to go out, oldest first
-  std::set<std::uint64_t> unacked;        // frames sent and not yet acknowledged
+  std::deque<std::string> texts;    // JSON events waiting to go out, oldest first
+  std::set<std::uint64_t> unacked;  // frames sent and not yet acknowledged
   std::uint64_t last_frame_sent = 0;
   bool sent_any_frame = false;
-  std::string rx;                         // a message arriving in fragments
+  std::string rx;  // a message arriving in fragments
   bool rx_oversize = false;
   std::size_t rx_total = 0;
 };
@@ -70,6 +70,15 @@ int callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, std::s
   auto* impl = static_cast<WsServer::Impl*>(lws_context_user(lws_get_context(wsi)));
   if (!impl) return 0;
   return impl->on_event(wsi, reason, in, len);
+}
+
+// The HTTP protocol: static files, and the handshakes that named no subprotocol of ours. lws binds an
+// upgrade without a Sec-WebSocket-Protocol header to its first protocol, this one; accepted, such a
+// socket got a 101 and then no callback ever answered it (100 held for 30 s were never closed). Refused
+// here, lws closes the connection before answering, as it does for a subprotocol it does not know.
+int http_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, std::size_t len) {
+  if (reason == LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION) return -1;
+  return lws_callback_http_dummy(wsi, reason, user, in, len);
 }
 
 // One lws_write of `bytes` with the LWS_PRE headroom lws needs in front of it.
@@ -142,7 +151,9 @@ int WsServer::Impl::on_event(lws* wsi, lws_callback_reasons reason, void* in, st
       if (whole) {
         if (oversize)
           handler.on_oversize(id, total);
-        else if (!lws_frame_is_binary(wsi))
+        else if (lws_frame_is_binary(wsi))
+          handler.on_binary(id, total);
+        else
           handler.on_text(id, message);
       }
       return 0;
@@ -190,7 +201,7 @@ WsServer::WsServer(const ServerOptions& options, WsHandler& handler)
     : impl_(std::make_unique<Impl>(options, handler)) {
   Impl& m = *impl_;
   lws_set_log_level(LLL_ERR, nullptr);
-  m.protocols.push_back({"http", lws_callback_http_dummy, 0, 0, 0, nullptr, 0});
+  m.protocols.push_back({"http", http_callback, 0, 0, 0, nullptr, 0});
   m.protocols.push_back({"thaw.v1", callback, 0, 4096, 0, nullptr, 0});
   m.protocols.push_back({nullptr, nullptr, 0, 0, 0, nullptr, 0});
   m.mount.mountpoint = "/";

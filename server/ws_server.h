@@ -4,6 +4,9 @@
 // text and frames through the thread-safe calls below, which wake the loop with lws_cancel_service;
 // only the loop writes to sockets (libwebsockets' rule).
 //
+// Handshakes: an upgrade must ask for the thaw.v1 subprotocol; one without it (or with another) is
+// refused with an HTTP error rather than accepted and left without a handler.
+//
 // Flow control: every client gets the newest frame when it can take one, with at most two frames it has
 // not acknowledged; older frames are dropped, never queued, so a slow client costs nothing but its own
 // frame rate.
@@ -17,8 +20,8 @@ namespace thaw {
 
 struct ServerOptions {
   std::string host = "127.0.0.1";
-  int port = 8080;         // 0: any free port (see WsServer::port())
-  std::string web_root;    // folder served over HTTP ("/" is its index.html)
+  int port = 8080;       // 0: any free port (see WsServer::port())
+  std::string web_root;  // folder served over HTTP ("/" is its index.html)
   std::size_t max_message_bytes = 16 * 1024;
   std::size_t max_queued_texts = 256;  // per client; beyond it the oldest queued text is dropped
   int frame_window = 2;                // unacknowledged frames per client
@@ -31,6 +34,7 @@ class WsHandler {
   virtual void on_open(std::uint64_t client, const std::string& peer_address) = 0;
   virtual void on_text(std::uint64_t client, std::string_view message) = 0;  // one whole message
   virtual void on_oversize(std::uint64_t client, std::size_t bytes) = 0;     // a message over the limit
+  virtual void on_binary(std::uint64_t client, std::size_t bytes) = 0;       // a whole binary message
   virtual void on_close(std::uint64_t client) = 0;
 };
 
