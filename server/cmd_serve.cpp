@@ -98,8 +98,11 @@ int cmd_serve(int argc, char** argv) {
   watcher.join();
   renderer.stop();
   service_ptr = nullptr;
-  if (auto out = args.value("--state-out")) session.save_state(*out);
+  // Stop first, then save: queued behind a backlog, the save waited for every command before it (40
+  // clients x 40 resets kept the server up 90 s after SIGTERM). stop() ends after the step or rebuild
+  // under way and fails the rest; the state written is the one the last finished command left.
   session.stop();
+  if (auto out = args.value("--state-out")) session.save_state(*out);
   if (!args.flag("--quiet")) std::printf("thaw serve: stopped\n");
   return 0;
 }

@@ -137,6 +137,7 @@ void Session::stop() {
   {
     std::lock_guard lock(queue_mutex_);
     stop_ = true;
+    stopping_ = true;
     // Without a thread nothing would ever answer what was queued before start().
     if (!thread_.joinable()) never_run.swap(queue_);
   }
@@ -150,27 +151,73 @@ void Session::stop() {
   }
 }
 
+namespace {
+
+// Which waiting command a rebuilding command replaces: "" for commands that never replace another.
+std::string rebuild_slot(const protocol::Command& c) {
+  if (std::holds_alternative<protocol::SimReset>(c) || std::holds_alternative<protocol::SceneLoad>(c) ||
+      std::holds_alternative<protocol::StateLoad>(c))
+    return "rebuild";
+  if (const auto* p = std::get_if<protocol::ParamSet>(&c)) return "param " + p->path;
+  return "";
+}
+
+}  // namespace
+
 void Session::submit(protocol::Command command, Done done) {
+  Done superseded, busy;
+  const std::string slot = rebuild_slot(command);
+  const std::string type = protocol::type_name(command);
+  std::size_t queued = 0;
   {
     std::lock_guard lock(queue_mutex_);
     if (!(stop_ && !thread_running_)) {
-      queue_.push_back({std::move(command), std::move(done)});
+      if (!slot.empty()) {
+        const auto same = std::find_if(queue_.begin(), queue_.end(), [&](const Pending& p) {
+          const auto* c = std::get_if<protocol::Command>(&p.what);
+          return c != nullptr && rebuild_slot(*c) == slot;
+        });
+        if (same != queue_.end()) {
+          superseded = std::move(same->done);
+          queue_.erase(same);
+        }
+      }
+      queued = queue_.size();
+      if (queued >= kMaxQueued) {
+        busy = std::move(done);
+      } else {
+        queue_.push_back({std::move(command), std::move(done)});
+      }
       done = nullptr;
     }
   }
   queue_cv_.notify_all();
+  if (superseded)
+    answer(superseded, ErrorCode::Failed, "superseded: a newer " + type + " arrived before this one ran",
+           Json::object());
+  if (busy)
+    answer(busy, ErrorCode::RateLimited,
+           "the simulation has " + std::to_string(queued) +
+               " commands waiting from all clients; try again shortly",
+           Json::object());
   if (done) done(ErrorCode::Failed, "the simulation has stopped", Json::object());
 }
 
 void Session::aim_dryer(int dryer, const Eigen::Vector3d& hit, Done done) {
+  Done busy;
   {
     std::lock_guard lock(queue_mutex_);
     if (!(stop_ && !thread_running_)) {
-      queue_.push_back({Aim{dryer, hit}, std::move(done)});
+      if (queue_.size() >= kMaxQueued)
+        busy = std::move(done);
+      else
+        queue_.push_back({Aim{dryer, hit}, std::move(done)});
       done = nullptr;
     }
   }
   queue_cv_.notify_all();
+  if (busy)
+    answer(busy, ErrorCode::RateLimited, "the simulation has too many commands waiting; try again", {});
   if (done) done(ErrorCode::Failed, "the simulation has stopped", Json::object());
 }
 
@@ -338,6 +385,11 @@ void Session::apply_pending(std::deque<Pending>& batch) {
   for (Pending& p : batch) {
     if (auto* task = std::get_if<Task>(&p.what)) {
       (*task)();
+      continue;
+    }
+    // Shutdown interrupts a batch: what is left of it only learns that it failed.
+    if (stopping_.load()) {
+      answers.push_back({std::move(p.done), Outcome{ErrorCode::Failed, "the simulation has stopped", {}}});
       continue;
     }
     Outcome o;

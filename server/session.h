@@ -8,6 +8,7 @@
 // (stepping, commands, snapshots, state files) runs on the session's own thread once started. The
 // accessors and submit() may be called from any thread.
 #include <Eigen/Core>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -51,9 +52,18 @@ class Session {
   Session& operator=(const Session&) = delete;
 
   void start();  // launches the simulation thread; it runs (not paused) from the start
-  void stop();   // finishes the step under way, fails the commands still queued, joins
+  // Finishes the step or command under way, fails the commands still queued (also those of a batch
+  // being applied), joins. Bounded by one step or one rebuild, whatever is queued.
+  void stop();
+  static constexpr std::size_t kMaxQueued = 512;
 
   // Thread-safe; applied on the session's thread before its next step. A `done` may be empty.
+  // Commands that rebuild the solver (sim.reset, scene.load, state.load, param.set) cost a rebuild each
+  // (about 0.25 s for the default scene on 2 cores), so a backlog of them once froze the stream for a
+  // minute: while one waits, a newer one takes its place and the older is answered Failed
+  // ("superseded"). Resets, scene and state loads share one place; a param.set shares it with those of
+  // the same path. And the queue holds at most kMaxQueued commands from all clients together; beyond
+  // that a command is answered RateLimited at once.
   // Presentation commands (hello, camera, view, quality, frame.ack) are the render side's business and
   // end in Failed; dryer.aim too, since it needs a pick: the render side picks, then calls aim_dryer().
   void submit(protocol::Command command, Done done = {});
@@ -158,6 +168,7 @@ class Session {
   std::condition_variable queue_cv_;
   std::deque<Pending> queue_;
   bool stop_ = false;
+  std::atomic<bool> stopping_{false};  // stop_ as the session's thread reads it between commands
   bool thread_running_ = false;
   std::thread thread_;
 

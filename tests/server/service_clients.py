@@ -8,7 +8,7 @@ fuzz: four clients send 6,000 random and malformed messages; then the server mus
 refuse a bad command. smoke: a dryer change, a state save, a refused path. Each prints what it saw,
 one line per check ("... True" or the refusal code), which the caller checks.
 """
-import asyncio, json, os, random, sys, websockets
+import asyncio, json, os, random, sys, time, websockets
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
 import thaw_client
@@ -66,6 +66,63 @@ async def fuzz(PORT):
             await thaw.command("dryer.set", dryer=0, speed=1000)
         except thaw_client.CommandError as e:
             print("still checking", e.code)
+
+async def count_frames(PORT, seconds, token=None, quality=None):
+    """Frames a viewer receives (and acknowledges) in `seconds`."""
+    async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/", token=token) as thaw:
+        if quality:
+            await thaw.command("quality.set", **quality)
+        await thaw.frame()
+        t0, n = time.time(), 0
+        while time.time() - t0 < seconds:
+            try:
+                await thaw.frame(timeout=max(0.1, seconds - (time.time() - t0)))
+                n += 1
+            except asyncio.TimeoutError:
+                break
+        return n
+async def resets(PORT, rate, seconds):
+    """sim.reset at `rate` a second for `seconds`; returns the slowest answer [s] and the answers' kinds."""
+    async with websockets.connect(f"ws://127.0.0.1:{PORT}/", subprotocols=["thaw.v1"], max_size=None) as ws:
+        sent, slowest, kinds = {}, 0.0, {}
+        async def read():
+            nonlocal slowest
+            async for m in ws:
+                if isinstance(m, str):
+                    j = json.loads(m)
+                    if j.get("id") in sent:
+                        slowest = max(slowest, time.time() - sent.pop(j["id"]))
+                        kinds[j["type"]] = kinds.get(j["type"], 0) + 1
+        reader = asyncio.ensure_future(read())
+        t0, k = time.time(), 0
+        while time.time() - t0 < seconds:
+            sent[k] = time.time()
+            await ws.send(json.dumps({"type": "sim.reset", "id": k}))
+            k += 1
+            await asyncio.sleep(1 / rate)
+        end = time.time() + DEADLINE
+        while sent and time.time() < end:
+            await asyncio.sleep(0.05)
+        reader.cancel()
+        return slowest, kinds, len(sent)
+async def backlog(PORT):
+    """A viewer's frames alone, then beside one client sending sim.reset at 19/s (under the rate limit)."""
+    alone = await count_frames(PORT, 4)
+    flood = asyncio.ensure_future(resets(PORT, 19, 6))
+    during = await count_frames(PORT, 6)
+    slowest, kinds, unanswered = await flood
+    print("frames alone %d in 4 s, during resets %d in 6 s" % (alone, during))
+    print("ratio %.2f" % ((during / 6) / max(alone / 4, 1e-9)))
+    print("slowest answer %.2f s, unanswered %d, kinds %s" % (slowest, unanswered, kinds))
+async def flood(PORT):
+    """40 clients each send 40 sim.reset as fast as they can."""
+    async def one():
+        async with websockets.connect(f"ws://127.0.0.1:{PORT}/", subprotocols=["thaw.v1"], max_size=None) as ws:
+            for k in range(40):
+                await ws.send(json.dumps({"type": "sim.reset", "id": k}))
+            await asyncio.sleep(0.5)
+    await asyncio.gather(*[one() for _ in range(40)])
+    print("flooded")
 
 async def smoke(PORT):
     async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/") as thaw:

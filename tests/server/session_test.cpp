@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <future>
+#include <map>
+#include <mutex>
 #include <thread>
 
 #include "server/render_worker.h"
@@ -224,6 +226,62 @@ TEST_F(SessionTest, StateSaveAndLoadRoundTripInsideTheStateFolder) {
   EXPECT_TRUE(std::filesystem::is_regular_file(dir_.path() / "running.state"));
   EXPECT_TRUE(std::filesystem::is_regular_file(dir_.path() / "stopped.state"));
   EXPECT_EQ(call(*s, protocol::SimResume{}).code, ErrorCode::Failed);  // answered, not left hanging
+}
+
+TEST_F(SessionTest, RebuildsCoalesceTheQueueIsBoundedAndStopInterruptsABacklog) {
+  // One client's sim.reset at 19/s once queued 190 rebuilds: acks 31 s late and no frames meanwhile.
+  auto s = make("ice-on-plate");
+  struct Tally {
+    std::mutex m;
+    std::map<std::string, int> by;
+    int answered = 0;
+  };
+  auto tally = std::make_shared<Tally>();
+  auto count = [tally](std::optional<ErrorCode> code, std::string message, Json) {
+    std::lock_guard lock(tally->m);
+    ++tally->answered;
+    ++tally->by[code ? std::string(protocol::error_code_name(*code)) + " " + message.substr(0, 10) : "ok"];
+  };
+  // Before start() nothing drains the queue: 200 resets leave one waiting, the other 199 superseded.
+  for (int i = 0; i < 200; ++i) s->submit(protocol::SimReset{}, count);
+  // A param.set replaces only the one of its own path.
+  s->submit(protocol::ParamSet{"heat.time_scale", 10}, count);
+  s->submit(protocol::ParamSet{"heat.time_scale", 20}, count);
+  s->submit(protocol::ParamSet{"solver.cfl", 0.3}, count);
+  {
+    std::lock_guard lock(tally->m);
+    EXPECT_EQ(tally->by["failed superseded"], 200);
+  }
+  // The queue is bounded across clients: what does not fit is refused at once.
+  for (std::size_t i = 0; i < Session::kMaxQueued + 40; ++i) s->submit(protocol::DryerSet{}, count);
+  {
+    std::lock_guard lock(tally->m);
+    EXPECT_EQ(tally->by["rate_limited the simula"], 43);  // 3 waited already
+  }
+  // Started, everything queued is answered; the newest param.set of a path is the one applied.
+  s->start();
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    {
+      std::lock_guard lock(tally->m);
+      if (tally->answered == 203 + int(Session::kMaxQueued) + 40) break;
+    }
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_EQ(s->scene()->heat.time_scale, 20.0);
+  EXPECT_EQ(s->scene()->solver.cfl, 0.3);
+  // stop() with a backlog: a batch being applied is cut short, whatever is left fails, quickly.
+  for (int i = 0; i < 300; ++i) {
+    s->submit(protocol::SimReset{}, count);
+    s->submit(protocol::SimStep{50}, count);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  s->stop();
+  const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(stop_s, 2.0);
+  std::printf("[ info ] stop() with a backlog of 300 resets and step requests: %.3f s\n", stop_s);
+  std::lock_guard lock(tally->m);
+  EXPECT_EQ(tally->answered, 203 + int(Session::kMaxQueued) + 40 + 600);
 }
 
 TEST_F(SessionTest, SceneLoadOnlyFromConfigs) {
