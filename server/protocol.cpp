@@ -502,11 +502,13 @@ const char* error_code_name(ErrorCode c) {
 const char* type_name(const Command& c) { return kTypeNames[c.index()]; }
 
 bool needs_controller(const Command& c) {
-  // Presentation is per client (its camera, view, image size, frame acks); anything else changes the one
-  // simulation every client watches.
+  // The camera and the view are cheap to change and bounded (the camera stays where it frames the
+  // scene); anything else changes the one simulation every client watches, or, for quality.set, the
+  // cost of the one frame every client shares: a viewer asking for 1920x1080 at full quality and 60
+  // frames a second cut everyone to under 1 frame a second and the simulation from 50 to 4-40 steps/s.
   return !(std::holds_alternative<Hello>(c) || std::holds_alternative<CameraSet>(c) ||
            std::holds_alternative<CameraOrbit>(c) || std::holds_alternative<ViewSet>(c) ||
-           std::holds_alternative<QualitySet>(c) || std::holds_alternative<FrameAck>(c));
+           std::holds_alternative<FrameAck>(c));
 }
 
 std::variant<Request, ParseError> parse(std::string_view text) {

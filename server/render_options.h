@@ -15,27 +15,31 @@
 namespace thaw {
 
 struct RenderOptions {
-  std::string view = "surface";         // surface | particles | slice
-  std::string colour_by = "phase";      // particles: phase | temperature
-  std::string quality = "full";         // surface: full | fast (SurfaceRenderer::Quality)
-  int slice_axis = 1;                   // slice: the plane's normal axis
-  double slice_position = 0.5;          // slice: fraction of the domain along it
+  std::string view = "surface";     // surface | particles | slice
+  std::string colour_by = "phase";  // particles: phase | temperature
+  std::string quality = "full";     // surface: full | fast (SurfaceRenderer::Quality)
+  int slice_axis = 1;               // slice: the plane's normal axis
+  double slice_position = 0.5;      // slice: fraction of the domain along it
   int width = 640, height = 480;
   double azimuth = 30.0, elevation = 25.0;
   double distance = 0.0;  // 0: frame the domain
   bool has_target = false;
   Eigen::Vector3d target = Eigen::Vector3d::Zero();  // default: the domain's centre
-  double fov = 40.0;                                  // vertical [deg]
+  double fov = 40.0;                                 // vertical [deg]
   FieldOptions field;
 };
 
 // The option names, for CliArgs: --size WxH, --camera AZ,EL[,DIST], --target X,Y,Z, --fov DEG, --view NAME,
 // --colour-by phase|temperature, --slice AXIS[,FRACTION], --field-cells N, --quality full|fast.
-inline const char* const kRenderValueOptions[] = {"--size",      "--camera", "--target",      "--fov",    "--view",
-                                                  "--colour-by", "--slice",  "--field-cells", "--quality"};
+inline const char* const kRenderValueOptions[] = {"--size",  "--camera",      "--target",
+                                                  "--fov",   "--view",        "--colour-by",
+                                                  "--slice", "--field-cells", "--quality"};
 
 // Reads the options; a malformed value is an Error naming the option and what was expected.
 RenderOptions render_options(const CliArgs& args);
+
+// How close and how far the camera may go, in multiples of the distance that frames the domain.
+inline constexpr double kClosest = 0.05, kFarthest = 8.0;
 
 // The camera for a snapshot: the options' angles, framing the scene's domain unless a distance is given.
 OrbitCamera camera_for(const RenderOptions& o, const RenderSnapshot& s);

@@ -22,6 +22,12 @@ double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
+// The frame rate within the pixel budget (RenderWorker::fps_limit).
+double fps_within_budget(double fps, const RenderOptions& o) {
+  const double weight = o.view == "surface" && o.quality == "full" ? RenderWorker::kFullQualityWeight : 1.0;
+  return std::min(fps, RenderWorker::kMaxPixelsPerSecond / (double(o.width) * o.height * weight));
+}
+
 }  // namespace
 
 // The GL side, made on the render thread the first time the surface view is drawn. FrameRenderer would
@@ -66,7 +72,7 @@ void RenderWorker::stop() {
 }
 
 void RenderWorker::run() {
-  auto next_allowed = Clock::now();
+  auto next_allowed = Clock::now(), next_budget = Clock::now();
   std::uint64_t drawn_version = 0;
   for (;;) {
     RenderOptions options;
@@ -75,9 +81,11 @@ void RenderWorker::run() {
     {
       std::unique_lock lock(mutex_);
       cv_.wait(lock, [&] {
-        return stop_ || ((snapshot_pending_ || options_version_ != drawn_version) && (watched_ || frames_ == 0));
+        return stop_ ||
+               ((snapshot_pending_ || options_version_ != drawn_version) && (watched_ || frames_ == 0));
       });
       // The fps cap: changes that arrive meanwhile merge into the next frame instead of queueing.
+      if (!stop_ && Clock::now() < next_budget) cv_.wait_until(lock, next_budget, [&] { return stop_; });
       if (!stop_ && !hurry_ && Clock::now() < next_allowed)
         cv_.wait_until(lock, next_allowed, [&] { return stop_ || hurry_; });
       if (stop_) break;
@@ -86,10 +94,15 @@ void RenderWorker::run() {
       drawn_version = options_version_;
       options = options_;
       quality = jpeg_quality_;
-      fps = fps_;
+      fps = fps_within_budget(fps_, options_);
     }
+    const auto started = Clock::now();
     next_allowed =
-        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / fps));
+        started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / fps));
+    // hurry() skips the frame-rate cap, not the pixel budget: commands at 50 a second must not turn
+    // into 50 large frames a second.
+    next_budget = started + std::chrono::duration_cast<Clock::duration>(
+                                std::chrono::duration<double>(1.0 / fps_within_budget(1e9, options)));
     if (auto snapshot = session_.latest_snapshot()) render_one(snapshot, options, quality);
   }
   // The context belongs to this thread: release it here, not in the destructor's thread.
@@ -221,23 +234,21 @@ void RenderWorker::set_camera(std::optional<double> azimuth, std::optional<doubl
 void RenderWorker::orbit(double d_azimuth, double d_elevation, double zoom) {
   if (!std::isfinite(d_azimuth) || !std::isfinite(d_elevation) || !(zoom > 0 && std::isfinite(zoom)))
     throw Error("camera.orbit: angles must be finite and zoom positive");
-  // Zooming a framed view (distance 0) starts from the distance the framing chose.
-  double framed = 0;
-  {
-    std::lock_guard lock(frame_mutex_);
-    if (pick_has_camera_) framed = picked_camera_.distance;
-  }
-  if (framed <= 0) {
-    if (auto s = session_.latest_snapshot()) framed = camera_for(options(), *s).distance;
+  // Zooming starts from the distance drawn now, and stays within what camera_for allows of the
+  // distance that frames the domain: repeated zooms out no longer pile up past it.
+  double drawn = 0, framing = 0;
+  if (auto s = session_.latest_snapshot()) {
+    RenderOptions o = options();
+    drawn = camera_for(o, *s).distance;
+    o.distance = 0;
+    framing = camera_for(o, *s).distance;
   }
   {
     std::lock_guard lock(mutex_);
     options_.azimuth = std::remainder(options_.azimuth + d_azimuth, 360.0);
     options_.elevation = std::clamp(options_.elevation + d_elevation, -89.0, 89.0);
-    if (zoom != 1.0) {
-      if (options_.distance <= 0) options_.distance = framed;
-      if (options_.distance > 0) options_.distance *= zoom;
-    }
+    if (zoom != 1.0 && drawn > 0)
+      options_.distance = std::clamp(drawn * zoom, kClosest * framing, kFarthest * framing);
     ++options_version_;
   }
   cv_.notify_all();
@@ -294,6 +305,11 @@ double RenderWorker::fps_cap() const {
   return fps_;
 }
 
+double RenderWorker::fps_limit() const {
+  std::lock_guard lock(mutex_);
+  return fps_within_budget(fps_, options_);
+}
+
 void RenderWorker::hurry() {
   {
     std::lock_guard lock(mutex_);
@@ -314,7 +330,8 @@ double RenderWorker::fps() const {
   constexpr double window_s = 2.0;
   const auto now = Clock::now();
   std::lock_guard lock(frame_mutex_);
-  const auto from = now - std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(window_s));
+  const auto from =
+      now - std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(window_s));
   std::size_t n = 0;
   for (const auto t : finished_) n += t >= from;
   return double(n) / window_s;

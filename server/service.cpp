@@ -195,6 +195,7 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
                 {"height", now.height},
                 {"jpeg_quality", renderer_.jpeg_quality()},
                 {"fps", renderer_.fps_cap()},
+                {"fps_limit", renderer_.fps_limit()},
                 {"surface", now.quality}});
         } else if constexpr (std::is_same_v<T, DryerAim>) {
           const auto hit = renderer_.pick(c.x, c.y);

@@ -39,7 +39,6 @@ function connect() {
     setState('connected', 'connected');
     const token = new URLSearchParams(location.search).get('token');
     send('hello', token ? { version: 1, token } : { version: 1 });
-    send('quality.set', { width: canvas.width, height: canvas.height });
   };
   ws.onclose = () => {
     setState('closed', 'disconnected; retrying');
@@ -79,6 +78,9 @@ function onEvent(m) {
       welcome = m;
       $('scene-name').textContent = m.scene;
       $('role').textContent = m.role === 'controller' ? '' : '(viewer: controls are off)';
+      // The frame is shared by every viewer, so only a controller sets its size and quality.
+      if (m.role === 'controller') send('quality.set', { width: canvas.width, height: canvas.height });
+      $('full-quality').disabled = m.role !== 'controller';
       fillSelect($('scene'), m.scenes || [], m.scene);
       dryers = m.dryers || [];
       fillSelect($('dryer'), dryers.map((_, i) => String(i)), '0');

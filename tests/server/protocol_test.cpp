@@ -549,8 +549,8 @@ TEST(ProtocolRefuse, FrameAck) {
 // ---- roles, names, events ----------------------------------------------------------------------------
 
 TEST(ProtocolRoles, NeedsControllerForWhatEveryoneSees) {
-  const std::vector<std::string> viewer = {"hello",    "camera.set",  "camera.orbit",
-                                           "view.set", "quality.set", "frame.ack"};
+  // quality.set sets the cost of the frame every client shares: controller only.
+  const std::vector<std::string> viewer = {"hello", "camera.set", "camera.orbit", "view.set", "frame.ack"};
   for (const std::string& text : valid_messages()) {
     const Command c = std::get<Request>(parse(text)).command;
     const bool presentation = std::find(viewer.begin(), viewer.end(), type_name(c)) != viewer.end();
@@ -561,6 +561,7 @@ TEST(ProtocolRoles, NeedsControllerForWhatEveryoneSees) {
   EXPECT_TRUE(needs_controller(StateLoad{}));
   EXPECT_FALSE(needs_controller(FrameAck{}));
   EXPECT_FALSE(needs_controller(Hello{}));
+  EXPECT_TRUE(needs_controller(QualitySet{}));
 }
 
 TEST(ProtocolEvents, ErrorCodeNames) {

@@ -362,6 +362,56 @@ class RenderWorkerTest : public testing::ClSuite {
   TempDir dir_{"render-worker"};
 };
 
+TEST_F(RenderWorkerTest, TheCameraStaysOnTheSceneAndFramesKeepWithinThePixelBudget) {
+  // camera.orbit with zoom 100, repeated, grew the distance without bound (3.5 s a frame); quality.set
+  // 1920x1080 at full quality and 60 frames a second dropped everyone under 1 frame a second.
+  Session s(cl(), "ice-on-plate", {"spacing=0.006"}, (dir_.path() / "states").string());
+  RenderWorker w(s);
+  const auto snapshot = s.latest_snapshot();
+  RenderOptions framed = w.options();
+  framed.distance = 0;
+  const double framing = camera_for(framed, *snapshot).distance;
+  ASSERT_GT(framing, 0);
+  for (int i = 0; i < 30; ++i) w.orbit(0, 0, 100);
+  EXPECT_LE(w.options().distance, kFarthest * framing * (1 + 1e-12));
+  EXPECT_LE(camera_for(w.options(), *snapshot).distance, kFarthest * framing * (1 + 1e-12));
+  for (int i = 0; i < 30; ++i) w.orbit(0, 0, 0.02);
+  EXPECT_GE(w.options().distance, kClosest * framing * (1 - 1e-12));
+  // camera.set takes any positive distance and any finite target; what is drawn stays bounded.
+  w.set_camera(std::nullopt, std::nullopt, 1e12, Eigen::Vector3d(1e9, -1e9, 0), std::nullopt);
+  const OrbitCamera far = camera_for(w.options(), *snapshot);
+  EXPECT_LE(far.distance, kFarthest * framing * (1 + 1e-12));
+  const double diagonal = (snapshot->domain_max - snapshot->domain_min).cast<double>().norm();
+  EXPECT_LE(far.target.x(), double(snapshot->domain_max.x()) + diagonal + 1e-9);
+  EXPECT_GE(far.target.y(), double(snapshot->domain_min.y()) - diagonal - 1e-9);
+
+  // The default frame is within the budget; the largest one is held to a frame rate the budget allows.
+  EXPECT_EQ(w.fps_limit(), w.fps_cap());
+  w.set_quality(1920, 1080, 95, 60.0, "full");
+  EXPECT_EQ(w.fps_cap(), 60.0);
+  EXPECT_NEAR(w.fps_limit(),
+              RenderWorker::kMaxPixelsPerSecond / (1920.0 * 1080 * RenderWorker::kFullQualityWeight), 1e-9);
+  EXPECT_LT(w.fps_limit(), 2.0);
+  // Drawn: over 3 s, hurried after every frame as 50 commands a second would, frames stay within it.
+  w.set_quality(960, 540, 80, 60.0, "fast");
+  const double limit = w.fps_limit();
+  ASSERT_LT(limit, 60.0);
+  s.start();
+  w.start();
+  auto first = w.wait_for_frame(0, 30s);
+  if (!first) GTEST_SKIP() << "no frames here: " << w.status();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::uint64_t last = first->frame;
+  while (std::chrono::steady_clock::now() - t0 < 3s) {
+    w.hurry();
+    if (auto f = w.wait_for_frame(last, 100ms)) last = f->frame;
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double rate = double(last - first->frame) / seconds;
+  std::printf("[ info ] 960x540 hurried: %.1f frames/s, budget %.1f\n", rate, limit);
+  EXPECT_LE(rate, limit * 1.1 + 0.5);
+}
+
 TEST_F(RenderWorkerTest, RendersNumberedJpegFramesAndPicksTheIce) {
   Session s(cl(), "ice-on-plate", {"spacing=0.006"}, (dir_.path() / "states").string());
   s.start();
