@@ -69,10 +69,14 @@ TEST(ServeLoad, ABacklogOfResetsNeitherFreezesTheStreamNorOutlivesSigterm) {
   const std::string out = run_clients(served, "backlog(PORT)", 120, &status);
   std::printf("%s", out.c_str());
   EXPECT_EQ(status, 0) << out;
-  // The stream keeps a good part of its rate (the rebuilds do take the simulation's core), and every
-  // reset is answered within a couple of rebuilds, not after a queue of them.
-  EXPECT_GT(number_after(out, "ratio "), 0.3) << out;
-  EXPECT_LT(number_after(out, "slowest answer "), 3.0) << out;
+  // The stream keeps a good part of its rate (the rebuilds do take the simulation's core: 0.72 quiet,
+  // 0.33 with 12 busy loops beside the 2 cores; before, about 0.05), and every reset is answered within a
+  // few rebuilds, not after a queue of them (before: 114 queued, 33 s). Both are relative to this run,
+  // so a loaded machine is only slower.
+  EXPECT_GT(number_after(out, "ratio "), 0.15) << out;
+  const double one = number_after(out, "one reset ");
+  ASSERT_GT(one, 0) << out;
+  EXPECT_LT(number_after(out, "slowest answer "), 4 * one + 1.0) << out;
   EXPECT_EQ(number_after(out, "unanswered "), 0) << out;
 
   const std::string flooded = run_clients(served, "flood(PORT)", 60, &status);

@@ -108,6 +108,11 @@ async def resets(PORT, rate, seconds):
 async def backlog(PORT):
     """A viewer's frames alone, then beside one client sending sim.reset at 19/s (under the rate limit)."""
     alone = await count_frames(PORT, 4)
+    # One reset on its own, timed in the same run: what a rebuild costs on this machine, loaded or not.
+    async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/") as thaw:
+        t0 = time.time()
+        await thaw.command("sim.reset", timeout=DEADLINE)
+        print("one reset %.2f s" % (time.time() - t0))
     flood = asyncio.ensure_future(resets(PORT, 19, 6))
     during = await count_frames(PORT, 6)
     slowest, kinds, unanswered = await flood
