@@ -20,6 +20,22 @@ cd "$work"
 # unmap" while unmapping a thread's alternate signal stack at thread exit, on every run on a fresh
 # machine; thaw installs no signal stacks of its own, so nothing of ours is hidden by turning it off.
 export ASAN_OPTIONS=detect_leaks=0:halt_on_error=1:use_sigaltstack=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+# The sanitizers' own failures are told apart from findings in our code, wherever the run stops (a
+# server the sanitizer stopped fails the clients' checks too, or never prints its port): either fails
+# the test, but the line printed says which.
+sanitizer_verdict() {
+  if grep -q "CHECK failed" serve.log; then
+    echo "FAIL: the sanitizer runtime itself failed (not a finding in thaw's code):"
+    grep "CHECK failed" serve.log
+    exit 1
+  fi
+  if grep -q "ERROR: AddressSanitizer\|runtime error:" serve.log; then
+    echo "FAIL: a sanitizer finding in thaw:"
+    grep -A3 "ERROR: AddressSanitizer\|runtime error:" serve.log
+    exit 1
+  fi
+}
+
 timeout 400 "$out/thaw" serve ice-on-plate --set spacing=0.006 --port 0 --state-dir states \
   --state-out final.state >serve.log 2>&1 &
 server=$!
@@ -27,10 +43,12 @@ port=""
 for _ in $(seq 1200); do
   port="$(grep -o '127.0.0.1:[0-9]*' serve.log | head -1 | cut -d: -f2 || true)"
   [ -n "$port" ] && break
+  kill -0 "$server" 2>/dev/null || break  # it stopped before serving
   sleep 0.1
 done
 if [ -z "$port" ]; then
   cat serve.log
+  sanitizer_verdict
   exit 1
 fi
 
@@ -39,20 +57,9 @@ kill -INT "$server"
 status=0
 wait "$server" || status=$?
 cat serve.log
+sanitizer_verdict
 for check in "frame True" "refused bad_field" "replies True" "still stepping True" "still checking bad_field"; do
   grep -q "$check" clients.log || { echo "missing: $check"; exit 1; }
 done
-# The sanitizers' own failures are told apart from findings in our code: either fails the test, but the
-# line printed says which it is.
-if grep -q "CHECK failed" serve.log; then
-  echo "FAIL: the sanitizer runtime itself failed (not a finding in thaw's code):"
-  grep "CHECK failed" serve.log
-  exit 1
-fi
-if grep -q "ERROR: AddressSanitizer\|runtime error:" serve.log; then
-  echo "FAIL: a sanitizer finding in thaw:"
-  grep -A3 "ERROR: AddressSanitizer\|runtime error:" serve.log
-  exit 1
-fi
 [ -f final.state ] || { echo "no --state-out"; exit 1; }
 exit "$status"
