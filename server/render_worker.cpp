@@ -22,10 +22,14 @@ double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-// The frame rate within the pixel budget (RenderWorker::fps_limit).
-double fps_within_budget(double fps, const RenderOptions& o) {
+// Frames a second the pixel budget allows for frames drawn with `o` (RenderWorker::fps_limit).
+double budget_fps(const RenderOptions& o) {
   const double weight = o.view == "surface" && o.quality == "full" ? RenderWorker::kFullQualityWeight : 1.0;
-  return std::min(fps, RenderWorker::kMaxPixelsPerSecond / (double(o.width) * o.height * weight));
+  return RenderWorker::kMaxPixelsPerSecond / (double(o.width) * o.height * weight);
+}
+
+Clock::duration seconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
 }
 
 }  // namespace
@@ -94,15 +98,13 @@ void RenderWorker::run() {
       drawn_version = options_version_;
       options = options_;
       quality = jpeg_quality_;
-      fps = fps_within_budget(fps_, options_);
+      fps = std::min(fps_, budget_fps(options_));
     }
     const auto started = Clock::now();
-    next_allowed =
-        started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / fps));
+    next_allowed = started + seconds(1.0 / fps);
     // hurry() skips the frame-rate cap, not the pixel budget: commands at 50 a second must not turn
     // into 50 large frames a second.
-    next_budget = started + std::chrono::duration_cast<Clock::duration>(
-                                std::chrono::duration<double>(1.0 / fps_within_budget(1e9, options)));
+    next_budget = started + seconds(1.0 / budget_fps(options));
     if (auto snapshot = session_.latest_snapshot()) render_one(snapshot, options, quality);
   }
   // The context belongs to this thread: release it here, not in the destructor's thread.
@@ -307,7 +309,7 @@ double RenderWorker::fps_cap() const {
 
 double RenderWorker::fps_limit() const {
   std::lock_guard lock(mutex_);
-  return fps_within_budget(fps_, options_);
+  return std::min(fps_, budget_fps(options_));
 }
 
 void RenderWorker::hurry() {
@@ -330,8 +332,7 @@ double RenderWorker::fps() const {
   constexpr double window_s = 2.0;
   const auto now = Clock::now();
   std::lock_guard lock(frame_mutex_);
-  const auto from =
-      now - std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(window_s));
+  const auto from = now - seconds(window_s);
   std::size_t n = 0;
   for (const auto t : finished_) n += t >= from;
   return double(n) / window_s;

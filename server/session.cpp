@@ -62,37 +62,6 @@ bool valid_state_name(const std::string& name) {
   });
 }
 
-// The first array index in a parameter path ("dryers[5].speed") past the end of its array in `doc`, as
-// "dryers[5] does not exist; the scene has 1": the protocol's not_found, not a bad field.
-std::optional<std::string> missing_element(const Json& doc, const std::string& path) {
-  const Json* node = &doc;
-  std::size_t at = 0;
-  std::string walked;
-  while (at < path.size() && node != nullptr) {
-    if (path[at] == '[') {
-      const std::size_t close = path.find(']', at);
-      if (close == std::string::npos || !node->is_array()) return std::nullopt;
-      const std::string digits = path.substr(at + 1, close - at - 1);
-      if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
-        return std::nullopt;
-      const std::size_t index = std::stoul(digits);
-      walked += path.substr(at, close + 1 - at);
-      if (index >= node->size())
-        return walked + " does not exist; the scene has " + std::to_string(node->size());
-      node = &(*node)[index];
-      at = close + 1;
-    } else {
-      if (path[at] == '.') ++at;
-      const std::size_t end = path.find_first_of(".[", at);
-      const std::string key = path.substr(at, end == std::string::npos ? std::string::npos : end - at);
-      walked += (walked.empty() ? "" : ".") + key;
-      node = node->is_object() && node->contains(key) ? &(*node)[key] : nullptr;
-      at = end == std::string::npos ? path.size() : end;
-    }
-  }
-  return std::nullopt;
-}
-
 // Completions run on the simulation thread; one that throws must not take the thread down with it.
 void answer(const Session::Done& done, std::optional<ErrorCode> code, const std::string& message,
             const Json& result) {
@@ -137,7 +106,6 @@ void Session::stop() {
   {
     std::lock_guard lock(queue_mutex_);
     stop_ = true;
-    stopping_ = true;
     // Without a thread nothing would ever answer what was queued before start().
     if (!thread_.joinable()) never_run.swap(queue_);
   }
@@ -165,13 +133,23 @@ std::string rebuild_slot(const protocol::Command& c) {
 }  // namespace
 
 void Session::submit(protocol::Command command, Done done) {
-  Done superseded, busy;
   const std::string slot = rebuild_slot(command);
   const std::string type = protocol::type_name(command);
+  enqueue({std::move(command), std::move(done)}, slot, type);
+}
+
+void Session::aim_dryer(int dryer, const Eigen::Vector3d& hit, Done done) {
+  enqueue({Aim{dryer, hit}, std::move(done)}, "", "dryer.aim");
+}
+
+void Session::enqueue(Pending pending, const std::string& slot, const std::string& type) {
+  Done superseded, busy, stopped;
   std::size_t queued = 0;
   {
     std::lock_guard lock(queue_mutex_);
-    if (!(stop_ && !thread_running_)) {
+    if (stop_ && !thread_running_) {
+      stopped = std::move(pending.done);
+    } else {
       if (!slot.empty()) {
         const auto same = std::find_if(queue_.begin(), queue_.end(), [&](const Pending& p) {
           const auto* c = std::get_if<protocol::Command>(&p.what);
@@ -183,12 +161,10 @@ void Session::submit(protocol::Command command, Done done) {
         }
       }
       queued = queue_.size();
-      if (queued >= kMaxQueued) {
-        busy = std::move(done);
-      } else {
-        queue_.push_back({std::move(command), std::move(done)});
-      }
-      done = nullptr;
+      if (queued >= kMaxQueued)
+        busy = std::move(pending.done);
+      else
+        queue_.push_back(std::move(pending));
     }
   }
   queue_cv_.notify_all();
@@ -200,25 +176,12 @@ void Session::submit(protocol::Command command, Done done) {
            "the simulation has " + std::to_string(queued) +
                " commands waiting from all clients; try again shortly",
            Json::object());
-  if (done) done(ErrorCode::Failed, "the simulation has stopped", Json::object());
+  if (stopped) answer(stopped, ErrorCode::Failed, "the simulation has stopped", Json::object());
 }
 
-void Session::aim_dryer(int dryer, const Eigen::Vector3d& hit, Done done) {
-  Done busy;
-  {
-    std::lock_guard lock(queue_mutex_);
-    if (!(stop_ && !thread_running_)) {
-      if (queue_.size() >= kMaxQueued)
-        busy = std::move(done);
-      else
-        queue_.push_back({Aim{dryer, hit}, std::move(done)});
-      done = nullptr;
-    }
-  }
-  queue_cv_.notify_all();
-  if (busy)
-    answer(busy, ErrorCode::RateLimited, "the simulation has too many commands waiting; try again", {});
-  if (done) done(ErrorCode::Failed, "the simulation has stopped", Json::object());
+bool Session::stopping() {
+  std::lock_guard lock(queue_mutex_);
+  return stop_;
 }
 
 void Session::save_state(const std::string& path) {
@@ -388,7 +351,7 @@ void Session::apply_pending(std::deque<Pending>& batch) {
       continue;
     }
     // Shutdown interrupts a batch: what is left of it only learns that it failed.
-    if (stopping_.load()) {
+    if (stopping()) {
       answers.push_back({std::move(p.done), Outcome{ErrorCode::Failed, "the simulation has stopped", {}}});
       continue;
     }
@@ -592,12 +555,13 @@ Session::Outcome Session::apply(const protocol::ParamSet& c) {
   const Field* field = find_field(scene_schema(), c.path);
   if (!field || !field->settable)
     return {ErrorCode::BadField, "path: '" + c.path + "' is not a parameter a client may change", {}};
-  if (const auto missing = missing_element(scene_.source, c.path)) return {ErrorCode::NotFound, *missing, {}};
   Scene scene;
   try {
     Json doc = scene_.source;
     apply_override(doc, c.path + "=" + c.value.dump());
     scene = scene_from_json(std::move(doc));
+  } catch (const IndexPastEndError& e) {
+    return {ErrorCode::NotFound, e.what(), {}};  // "dryers[5]: index 5 is past the end (...)"
   } catch (const Error& e) {
     return {ErrorCode::BadField, e.what(), {}};
   }

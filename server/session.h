@@ -8,7 +8,6 @@
 // (stepping, commands, snapshots, state files) runs on the session's own thread once started. The
 // accessors and submit() may be called from any thread.
 #include <Eigen/Core>
-#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -121,6 +120,10 @@ class Session {
   };
 
   void run();
+  // Queues `pending` unless the queue is full, first replacing the waiting command of the same
+  // rebuild slot (none when `slot` is empty); answers what was replaced, refused or too late.
+  void enqueue(Pending pending, const std::string& slot, const std::string& type);
+  bool stopping();  // stop() was called (the session's thread asks between commands)
   bool wait_for_work(std::optional<std::chrono::steady_clock::time_point> until);
   void apply_pending(std::deque<Pending>& batch);
   Outcome apply(const protocol::Command& command, Done& done, bool& deferred);
@@ -168,7 +171,6 @@ class Session {
   std::condition_variable queue_cv_;
   std::deque<Pending> queue_;
   bool stop_ = false;
-  std::atomic<bool> stopping_{false};  // stop_ as the session's thread reads it between commands
   bool thread_running_ = false;
   std::thread thread_;
 

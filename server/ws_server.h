@@ -5,7 +5,8 @@
 // only the loop writes to sockets (libwebsockets' rule).
 //
 // Handshakes: an upgrade must ask for the thaw.v1 subprotocol; one without it (or with another) is
-// refused with an HTTP error rather than accepted and left without a handler.
+// refused, the connection closed before any response (lws sends no status in that phase), rather than
+// accepted with a 101 and left without a handler.
 //
 // Flow control: every client gets the newest frame when it can take one, with at most two frames it has
 // not acknowledged; older frames are dropped, never queued, so a slow client costs nothing but its own

@@ -218,9 +218,9 @@ void set_at_path(Json& doc, std::string_view path, Json value, const Field* sche
       const std::size_t index = std::stoul(token.text);
       where = join_path(where, index);
       if (index >= node->size()) {
-        throw SceneError(where, "index " + token.text + " is past the end (the array has " +
-                                    std::to_string(node->size()) + " element" +
-                                    (node->size() == 1 ? "" : "s") + ")");
+        throw IndexPastEndError(where, "index " + token.text + " is past the end (the array has " +
+                                           std::to_string(node->size()) + " element" +
+                                           (node->size() == 1 ? "" : "s") + ")");
       }
       node = &(*node)[index];
     } else {

@@ -16,6 +16,8 @@
 #include <string_view>
 #include <vector>
 
+#include "sim/error.h"
+
 namespace thaw {
 
 using Json = nlohmann::ordered_json;
@@ -88,10 +90,17 @@ void validate(Json& value, const Field& field, const std::string& path = "");
 std::string join_path(const std::string& path, std::string_view key);
 std::string join_path(const std::string& path, std::size_t index);
 
+// An index past an array's end: the path is well formed, the element does not exist (the protocol's
+// not_found, where other path errors are a bad field).
+class IndexPastEndError : public SceneError {
+ public:
+  using SceneError::SceneError;
+};
+
 // Sets the value at "a.b[2].c" (or "a.b.2.c"). A key missing from the document is created: from its
 // default in `schema` when it declares one (so "gravity[2]" works on a defaulted gravity), else empty,
 // so that validation then reports an unknown key at its own path. Indexing past an array's end, or into
-// a value that is not an object or array, is a SceneError naming the path.
+// a value that is not an object or array, is a SceneError naming the path (IndexPastEndError for the first).
 void set_at_path(Json& doc, std::string_view path, Json value, const Field* schema = nullptr);
 
 // The declaration at a path such as "solver.cfl", "materials.water.density" or "fluids[0].box"

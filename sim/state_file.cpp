@@ -519,17 +519,16 @@ void check_state(const SimState& s, const Scene& scene, const std::string& origi
       if (!std::isfinite(v[std::size_t(k)])) return false;
     return true;
   };
-  const auto vec = [&num](const Float4& v) {
-    return "(" + num(v[0]) + ", " + num(v[1]) + ", " + num(v[2]) + ")";
+  const auto vec = [&num](const auto& v) {
+    return "(" + num(double(v[0])) + ", " + num(double(v[1])) + ", " + num(double(v[2])) + ")";
   };
   for (std::size_t i = 0; i < p.size(); ++i) {
     const Float4& x = p.position[i];
     if (!finite4(x, 3)) refuse(where("position", i) + vec(x) + " is not finite");
     if (!region.contains(Eigen::Vector3d(x[0], x[1], x[2])))
       refuse(where("position", i) + vec(x) +
-             " m lies outside the region this scene's particles can occupy, " + "from " +
-             vec({float(region.min().x()), float(region.min().y()), float(region.min().z()), 0}) + " to " +
-             vec({float(region.max().x()), float(region.max().y()), float(region.max().z()), 0}) + " m");
+             " m lies outside the region this scene's particles can occupy, " + "from " + vec(region.min()) +
+             " to " + vec(region.max()) + " m");
     if (!std::isfinite(x[3]) || !(x[3] > 0))
       refuse(where("position", i) + "mass " + num(x[3]) + " kg is not finite and positive");
     if (!finite4(p.velocity[i], 3)) refuse(where("velocity", i) + vec(p.velocity[i]) + " is not finite");

@@ -320,7 +320,7 @@ TEST_F(SessionTest, ParamSetTakesEffectAndKeepsTheParticles) {
   // An index past the scene's array is not_found, as PROTOCOL.md says (it was bad_field).
   const Reply missing = call(*s, protocol::ParamSet{"dryers[5].speed", 5});
   EXPECT_EQ(missing.code, ErrorCode::NotFound) << missing.message;
-  EXPECT_NE(missing.message.find("dryers[5] does not exist; the scene has"), std::string::npos)
+  EXPECT_EQ(missing.message.rfind("dryers[5]: index 5 is past the end (the array has 0 elements)", 0), 0u)
       << missing.message;
   ASSERT_FALSE(call(*s, protocol::SimStep{2}).code);
 }
@@ -399,7 +399,13 @@ TEST_F(RenderWorkerTest, TheCameraStaysOnTheSceneAndFramesKeepWithinThePixelBudg
   s.start();
   w.start();
   auto first = w.wait_for_frame(0, 30s);
-  if (!first) GTEST_SKIP() << "no frames here: " << w.status();
+  if (!first && w.status().rfind("error", 0) == 0) {
+    // No EGL here: the CPU particle view is drawn under the same budget.
+    std::printf("surface view unavailable (%s); timing the particle view\n", w.status().c_str());
+    w.set_view("particles");
+    first = w.wait_for_frame(0, 30s);
+  }
+  ASSERT_TRUE(first) << w.status();
   const auto t0 = std::chrono::steady_clock::now();
   std::uint64_t last = first->frame;
   while (std::chrono::steady_clock::now() - t0 < 3s) {
