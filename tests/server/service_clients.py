@@ -11,7 +11,7 @@ one line per check ("... True" or the refusal code), which the caller checks.
 import asyncio, json, os, random, sys, time, websockets
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
-import thaw_client
+import hardening_figures, thaw_client
 VALID = [{"type": "sim.pause"}, {"type": "sim.resume"}, {"type": "dryer.set", "dryer": 0, "on": True},
          {"type": "camera.orbit", "d_azimuth": 5}, {"type": "view.set", "view": "particles"},
          {"type": "quality.set", "width": 320, "height": 240}, {"type": "state.save", "name": "fz"},
@@ -67,66 +67,24 @@ async def fuzz(PORT):
         except thaw_client.CommandError as e:
             print("still checking", e.code)
 
-async def count_frames(PORT, seconds, token=None, quality=None):
-    """Frames a viewer receives (and acknowledges) in `seconds`."""
-    async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/", token=token) as thaw:
-        if quality:
-            await thaw.command("quality.set", **quality)
-        await thaw.frame()
-        t0, n = time.time(), 0
-        while time.time() - t0 < seconds:
-            try:
-                await thaw.frame(timeout=max(0.1, seconds - (time.time() - t0)))
-                n += 1
-            except asyncio.TimeoutError:
-                break
-        return n
-async def resets(PORT, rate, seconds):
-    """sim.reset at `rate` a second for `seconds`; returns the slowest answer [s] and the answers' kinds."""
-    async with websockets.connect(f"ws://127.0.0.1:{PORT}/", subprotocols=["thaw.v1"], max_size=None) as ws:
-        sent, slowest, kinds = {}, 0.0, {}
-        async def read():
-            nonlocal slowest
-            async for m in ws:
-                if isinstance(m, str):
-                    j = json.loads(m)
-                    if j.get("id") in sent:
-                        slowest = max(slowest, time.time() - sent.pop(j["id"]))
-                        kinds[j["type"]] = kinds.get(j["type"], 0) + 1
-        reader = asyncio.ensure_future(read())
-        t0, k = time.time(), 0
-        while time.time() - t0 < seconds:
-            sent[k] = time.time()
-            await ws.send(json.dumps({"type": "sim.reset", "id": k}))
-            k += 1
-            await asyncio.sleep(1 / rate)
-        end = time.time() + DEADLINE
-        while sent and time.time() < end:
-            await asyncio.sleep(0.05)
-        reader.cancel()
-        return slowest, kinds, len(sent)
 async def backlog(PORT):
     """A viewer's frames alone, then beside one client sending sim.reset at 19/s (under the rate limit)."""
-    alone = await count_frames(PORT, 4)
+    url = f"ws://127.0.0.1:{PORT}/"
+    alone = sum(await hardening_figures.frames_per_window(url, 4, 4))
     # One reset on its own, timed in the same run: what a rebuild costs on this machine, loaded or not.
-    async with thaw_client.connect(f"ws://127.0.0.1:{PORT}/") as thaw:
+    async with thaw_client.connect(url) as thaw:
         t0 = time.time()
         await thaw.command("sim.reset", timeout=DEADLINE)
         print("one reset %.2f s" % (time.time() - t0))
-    flood = asyncio.ensure_future(resets(PORT, 19, 6))
-    during = await count_frames(PORT, 6)
+    flood = asyncio.ensure_future(hardening_figures.resets(url, 19, 6, DEADLINE))
+    during = sum(await hardening_figures.frames_per_window(url, 6, 6))
     slowest, kinds, unanswered = await flood
     print("frames alone %d in 4 s, during resets %d in 6 s" % (alone, during))
     print("ratio %.2f" % ((during / 6) / max(alone / 4, 1e-9)))
     print("slowest answer %.2f s, unanswered %d, kinds %s" % (slowest, unanswered, kinds))
 async def flood(PORT):
     """40 clients each send 40 sim.reset as fast as they can."""
-    async def one():
-        async with websockets.connect(f"ws://127.0.0.1:{PORT}/", subprotocols=["thaw.v1"], max_size=None) as ws:
-            for k in range(40):
-                await ws.send(json.dumps({"type": "sim.reset", "id": k}))
-            await asyncio.sleep(0.5)
-    await asyncio.gather(*[one() for _ in range(40)])
+    await hardening_figures.flood(f"ws://127.0.0.1:{PORT}/")
     print("flooded")
 
 async def smoke(PORT):
