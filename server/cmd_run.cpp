@@ -1,4 +1,5 @@
 // `thaw run`: a headless run of a scene, with metrics, particle exports and state files.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -125,6 +126,14 @@ int cmd_run(int argc, char** argv) {
     std::printf("thaw run: scene '%s', %zu particles (water %zu, ice %zu, solid %zu) on %s\n",
                 scene.name.c_str(), solver.size(), counts.count(Phase::Water), counts.count(Phase::Ice),
                 counts.count(Phase::Solid), cl.description().c_str());
+  if (!quiet) {
+    const std::vector<std::string> built = solver.stages();
+    std::string stages;
+    for (const std::string& s : built) stages += (stages.empty() ? "" : ", ") + s;
+    std::printf("thaw run: stages built: %s\n", stages.c_str());
+    if (std::none_of(built.begin(), built.end(), [](const std::string& s) { return s.starts_with("heat"); }))
+      std::printf("thaw run: %s\n", solver.heat_reason().c_str());
+  }
   std::fflush(stdout);
 
   std::signal(SIGINT, on_signal);

@@ -18,7 +18,6 @@
 namespace thaw {
 namespace {
 
-
 // Shortest text that reads back as the same double, so frame times in the .pvd are exact.
 std::string exact(double v) {
   std::array<char, 32> buf{};
@@ -92,6 +91,21 @@ std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::
     t.bytes.reserve(4 * n);
     for (std::size_t i : order) put_little_endian(t.bytes, temperature[i]);
     arrays.push_back(std::move(t));
+  }
+  // Every field a stage declared as exported (sim/particle_fields.h), element by element in id order.
+  for (const HostColumn& c : p.columns) {
+    if (!c.spec.exported || c.size() != p.size()) continue;
+    VtkArray a{c.spec.name, vtk_scalar(c.spec.type), c.spec.width, {}};
+    const std::size_t element = c.spec.bytes(), word = scalar_bytes(c.spec.type);
+    a.bytes.reserve(element * n);
+    for (std::size_t i : order) {
+      const std::uint8_t* e = c.bytes.data() + i * element;
+      for (std::size_t k = 0; k < element; k += word)
+        for (std::size_t b = 0; b < word; ++b)  // little-endian whatever the host
+          a.bytes.push_back(
+              static_cast<char>(std::endian::native == std::endian::little ? e[k + b] : e[k + word - 1 - b]));
+    }
+    arrays.push_back(std::move(a));
   }
   return arrays;
 }

@@ -2,7 +2,10 @@
 // Host copy of the per-particle state, structure of arrays, in the device's current (sorted) order.
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
+
+#include "sim/particle_fields.h"
 
 namespace thaw {
 
@@ -29,10 +32,30 @@ struct HostParticles {
   std::vector<Float2> enthalpy;
   // 1 for ice held in place (an ice entry with motion "fixed"), 0 for every other particle.
   std::vector<std::uint8_t> anchored;
+  // Fields a stage declares beyond the members above (rigid ice's "body" and "body_offset"), as the
+  // device store downloads them and state files carry them (sim/particle_fields.h).
+  std::vector<HostColumn> columns;
 
   std::size_t size() const { return position.size(); }
-  void resize(std::size_t n);
+  void resize(std::size_t n);  // every member and column
   std::size_t count(Phase p) const;
+  const HostColumn* column(const std::string& name) const;
+  HostColumn* column(const std::string& name);
 };
+
+// The fields every run has on the device (position, velocity, density, phase, material, id), declared
+// once; the heat stage adds enthalpy. Each is a member of HostParticles (member_bytes).
+const std::vector<FieldSpec>& core_fields();
+
+// A member of HostParticles by its field name (the core fields, "enthalpy" and "anchored"): its bytes,
+// its element size and count; {nullptr, 0, 0} for any other name.
+struct MemberBytes {
+  void* data = nullptr;
+  std::size_t element = 0, count = 0;
+};
+MemberBytes member_bytes(HostParticles& p, const std::string& name);
+inline MemberBytes member_bytes(const HostParticles& p, const std::string& name) {
+  return member_bytes(const_cast<HostParticles&>(p), name);
+}
 
 }  // namespace thaw

@@ -76,40 +76,30 @@ RigidBody body_from_vector(const std::vector<double>& v) {
 
 }  // namespace
 
-RigidIce::RigidIce(ClRuntime& cl, const std::string& build_options, std::size_t n, Settings settings,
-                   std::vector<std::uint8_t> anchored_by_id, std::vector<float> mass_scale)
+RigidIce::RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build_options, std::size_t n,
+                   Settings settings, std::vector<std::uint8_t> anchored_by_id, std::vector<float> mass_scale)
     : cl_(cl),
+      store_(store),
       settings_(std::move(settings)),
       anchored_by_id_(std::move(anchored_by_id)),
       mass_scale_(std::move(mass_scale)) {
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "rigid.cl"}, build_options);
   k_forces_ = cl::Kernel(program, "rigid_forces");
   k_place_ = cl::Kernel(program, "rigid_place");
-  k_reorder_ = cl::Kernel(program, "rigid_reorder");
   labeller_ = std::make_unique<IceLabeller>(cl, settings_.grid_reach);
   reducer_ = std::make_unique<BodyReducer>(cl, mass_scale_);
   auto& ctx = cl.context();
   const std::size_t m = std::max<std::size_t>(n, 1);
-  body_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, m * 4);
-  spare_body_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, m * 4);
-  offset_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, m * 16);
-  spare_offset_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, m * 16);
+  // Each particle's body (kNoBody: none) and its offset in the body's frame, sorted with the particles.
+  body_ = store.add({"body", FieldType::UInt32, 1, true, true, kNoBody});
+  offset_ = store.add({"body_offset", FieldType::Float32, 4});
   force_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, m * 16);
   label_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, m * 4);
-  cl.queue().enqueueFillBuffer(body_, cl_uint(kNoBody), 0, m * 4);
-  cl.queue().enqueueFillBuffer(offset_, 0.0f, 0, m * 16);
   bodies_capacity_ = 0;
   upload_bodies();
 }
 
 RigidIce::~RigidIce() = default;
-
-void RigidIce::reorder(const cl::Buffer& order, std::uint32_t n) {
-  set_args(k_reorder_, order, n, body_, spare_body_, offset_, spare_offset_);
-  launch(cl_.queue(), k_reorder_, n);
-  std::swap(body_, spare_body_);
-  std::swap(offset_, spare_offset_);
-}
 
 void RigidIce::upload_bodies() {
   std::vector<ClBody> out(std::max<std::size_t>(bodies_.size(), 1));
@@ -144,7 +134,7 @@ void RigidIce::relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool
   const SortedIceParticles sorted{
       p.position,   p.phase, p.id,
       p.cell_start, p.n,     static_cast<std::uint32_t>(std::max<std::size_t>(anchored_by_id_.size(), n)),
-      body_};
+      store_[body_]};
   last_iterations_ = static_cast<int>(
       labeller_->label(sorted, p.grid, static_cast<float>(kConnectSpacings * settings_.spacing), label_));
   // The bodies follow from the labels on the host: this runs only when ice changed phase.
@@ -215,8 +205,8 @@ void RigidIce::relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool
   }
   bodies_ = std::move(bodies);
   shapes_ = std::move(shapes);
-  q.enqueueWriteBuffer(body_, CL_FALSE, 0, n * 4, body.data());
-  q.enqueueWriteBuffer(offset_, CL_TRUE, 0, n * 16, offset.data());
+  q.enqueueWriteBuffer(store_[body_], CL_FALSE, 0, n * 4, body.data());
+  q.enqueueWriteBuffer(store_[offset_], CL_TRUE, 0, n * 16, offset.data());
   upload_bodies();
   labelled_ = true;
   labelled_step_ = step;
@@ -228,9 +218,10 @@ void RigidIce::compute_forces(const ParticleBuffers& p) {
   const ContactModel& c = settings_.contact;
   const ClContact contact{float(c.stiffness), float(c.damping), float(c.friction), float(c.distance)};
   const float h = static_cast<float>(settings_.smoothing);
-  set_args(k_forces_, p.position, p.velocity, p.state, p.phase, body_, bodies_dev_, p.cell_start, p.grid,
-           static_cast<float>(settings_.support), 0.01f * h * h, static_cast<float>(settings_.visc_boundary),
-           static_cast<float>(settings_.rest_density), contact, force_, p.n);
+  set_args(k_forces_, p.position, p.velocity, p.state, p.phase, store_[body_], bodies_dev_, p.cell_start,
+           p.grid, static_cast<float>(settings_.support), 0.01f * h * h,
+           static_cast<float>(settings_.visc_boundary), static_cast<float>(settings_.rest_density), contact,
+           force_, p.n);
   launch(cl_.queue(), k_forces_, p.n);
 }
 
@@ -245,8 +236,8 @@ double RigidIce::max_point_speed() const {
 
 void RigidIce::advance(const ParticleBuffers& p, double dt) {
   if (bodies_.empty()) return;
-  const std::vector<BodySums> sums = reducer_->reduce({p.position, p.material, force_, body_, p.n}, refs_,
-                                                      static_cast<std::uint32_t>(bodies_.size()));
+  const std::vector<BodySums> sums = reducer_->reduce({p.position, p.material, force_, store_[body_], p.n},
+                                                      refs_, static_cast<std::uint32_t>(bodies_.size()));
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     RigidBody& r = bodies_[b].body;
     if (r.fixed || held_) continue;
@@ -254,7 +245,7 @@ void RigidIce::advance(const ParticleBuffers& p, double dt) {
     if (confine(b)) ++clamped_;
   }
   upload_bodies();
-  set_args(k_place_, p.position, p.velocity, p.phase, body_, offset_, bodies_dev_, p.n);
+  set_args(k_place_, p.position, p.velocity, p.phase, store_[body_], store_[offset_], bodies_dev_, p.n);
   launch(cl_.queue(), k_place_, p.n);
 }
 
@@ -296,14 +287,8 @@ std::vector<Float4> RigidIce::forces(std::size_t n) const {
   return out;
 }
 
-RigidIce::Saved RigidIce::save(std::size_t n) const {
+RigidIce::Saved RigidIce::save() const {
   Saved s;
-  s.body.resize(n);
-  s.offset.resize(n);
-  if (n) {
-    cl_.queue().enqueueReadBuffer(body_, CL_FALSE, 0, n * 4, s.body.data());
-    cl_.queue().enqueueReadBuffer(offset_, CL_TRUE, 0, n * 16, s.offset.data());
-  }
   s.bodies = {double(labelled_), double(labelled_step_), double(phase_changed_), double(labellings_)};
   // The last labelling's sweeps, then each body's shape as that labelling left it (particles that have
   // melted since included, as the running solver has it): its particle count and their offsets.
@@ -323,13 +308,8 @@ RigidIce::Saved RigidIce::save(std::size_t n) const {
   return s;
 }
 
-void RigidIce::restore(const Saved& s, std::size_t n) {
-  if (s.body.size() != n || s.offset.size() != n || s.bodies.size() < 4)
-    throw Error("rigid ice state: the body sections do not match the particles");
-  if (n) {
-    cl_.queue().enqueueWriteBuffer(body_, CL_FALSE, 0, n * 4, s.body.data());
-    cl_.queue().enqueueWriteBuffer(offset_, CL_TRUE, 0, n * 16, s.offset.data());
-  }
+void RigidIce::restore(const Saved& s) {
+  if (s.bodies.size() < 4) throw Error("rigid ice state: the rigid_bodies section is too short");
   labelled_ = s.bodies[0] != 0;
   labelled_step_ = static_cast<std::uint64_t>(s.bodies[1]);
   phase_changed_ = s.bodies[2] != 0;
@@ -363,10 +343,16 @@ void RigidIce::restore(const Saved& s, std::size_t n) {
     }
     if (at != s.labelling.size()) throw Error("rigid ice state: the body shapes do not match the bodies");
   } else {
-    // Files written before the shapes were kept: each body's particles now.
+    // Files written before the shapes were kept: each body's particles now (uploaded with the fields).
+    const std::size_t n = store_.size();
+    std::vector<std::uint32_t> body(n);
+    std::vector<Float4> offset(n);
+    if (n) {
+      cl_.queue().enqueueReadBuffer(store_[body_], CL_FALSE, 0, n * 4, body.data());
+      cl_.queue().enqueueReadBuffer(store_[offset_], CL_TRUE, 0, n * 16, offset.data());
+    }
     for (std::size_t i = 0; i < n; ++i)
-      if (s.body[i] < bodies_.size())
-        shapes_[s.body[i]].emplace_back(s.offset[i][0], s.offset[i][1], s.offset[i][2]);
+      if (body[i] < bodies_.size()) shapes_[body[i]].emplace_back(offset[i][0], offset[i][1], offset[i][2]);
   }
   upload_bodies();
 }

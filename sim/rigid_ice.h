@@ -25,6 +25,7 @@
 #include "sim/cl_grid.h"
 #include "sim/cl_runtime.h"
 #include "sim/ice_bodies.h"
+#include "sim/particle_store.h"
 #include "sim/particles.h"
 #include "sim/rigid_body.h"
 #include "sim/scene.h"
@@ -80,12 +81,12 @@ class RigidIce {
   // `build_options` are the solver's program options (kernel, lanes, reach); `anchored_by_id[id]` is 1
   // for particles of fixed ice objects; `mass_scale[material]` turns a particle's SPH mass into its
   // physical mass (ice is sampled with the fluid's rest mass; sim/thermal.h).
-  RigidIce(ClRuntime& cl, const std::string& build_options, std::size_t n, Settings settings,
-           std::vector<std::uint8_t> anchored_by_id, std::vector<float> mass_scale);
+  // Declares its per-particle fields ("body", "body_offset") in `store`, which must outlive it and be
+  // allocated before the first step.
+  RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build_options, std::size_t n,
+           Settings settings, std::vector<std::uint8_t> anchored_by_id, std::vector<float> mass_scale);
   ~RigidIce();
 
-  // The body index and offset of each particle follow the neighbour sort's permutation.
-  void reorder(const cl::Buffer& order, std::uint32_t n);
   // After the sort: labels the ice into bodies when a phase change of ice asked for it (or `force`).
   void relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool force = false);
   // After the density pass: the force on each ice particle of a free body.
@@ -108,16 +109,14 @@ class RigidIce {
   std::uint64_t clamped() const { return clamped_; }
   int last_iterations() const { return last_iterations_; }
 
-  // State for state files: per particle (sorted order) the body index and body-frame offset; the bodies
-  // and the labelling schedule as doubles; the last labelling's sweeps (empty: 0, as in older files).
+  // State for state files beyond the per-particle fields (which the store saves): the bodies and the
+  // labelling schedule as doubles; the last labelling's sweeps (empty: 0, as in older files).
   struct Saved {
-    std::vector<std::uint32_t> body;
-    std::vector<Float4> offset;
     std::vector<double> bodies;
     std::vector<double> labelling;
   };
-  Saved save(std::size_t n) const;
-  void restore(const Saved& s, std::size_t n);
+  Saved save() const;
+  void restore(const Saved& s);
 
  private:
   void upload_bodies();
@@ -125,13 +124,15 @@ class RigidIce {
   bool confine(std::size_t b);
 
   ClRuntime& cl_;
+  ParticleStore& store_;
   Settings settings_;
   std::vector<std::uint8_t> anchored_by_id_;
   std::vector<float> mass_scale_;
   std::unique_ptr<IceLabeller> labeller_;
   std::unique_ptr<BodyReducer> reducer_;
-  cl::Kernel k_forces_, k_place_, k_reorder_;
-  cl::Buffer body_, spare_body_, offset_, spare_offset_, force_, label_, bodies_dev_, refs_;
+  cl::Kernel k_forces_, k_place_;
+  ParticleStore::Field body_ = 0, offset_ = 0;
+  cl::Buffer force_, label_, bodies_dev_, refs_;
   std::size_t bodies_capacity_ = 0;
   std::vector<IceBody> bodies_;
   std::vector<std::vector<Eigen::Vector3f>> shapes_;  // each body's particle offsets in its own frame

@@ -228,7 +228,12 @@ const Field& scene_schema() {
           object(
               "heat",
               {
-                  flag("enabled", "Run the thermal stages: conduction, heat sources, phase change").def(true),
+                  flag("enabled",
+                       "Run the thermal stages (conduction, heat sources, phase change) when the scene needs "
+                       "them: particles at different temperatures, air or tank walls at another temperature, "
+                       "or a dryer or lamp. A scene without any of these builds no heat stage (`thaw run` "
+                       "says which stages it built); false: never")
+                      .def(true),
                   number("time_scale",
                          "Heat flows this many times faster than the water moves: 1 is physical; interactive "
                          "scenes may raise it and say so in their description")

@@ -171,7 +171,7 @@ EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
 }
 
 Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
-    : cl_(cl), scene_(scene), k_(derive_constants(scene)) {
+    : cl_(cl), scene_(scene), k_(derive_constants(scene)), store_(cl) {
   const HostParticles& p = st.particles;
   n_ = p.size();
   time_ = st.time;
@@ -243,15 +243,21 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   // start (measured: docs/BENCHMARKS.md). Nothing physical lives below 1e-38.
   opts << " -cl-denorms-are-zero";
   opts << " -DTHAW_REACH=" << kGridReach << " -DTHAW_VW=" << kLanes;
+  const HeatPlan plan = plan_heat(scene, p);
+  heat_ = plan.build;
+  heat_reason_ = plan.reason;
   const auto grid =
       cl.build(with_prelude({"grid.cl"}), opts.str() + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_));
   const auto boundary = cl.build(with_prelude({"boundary.cl"}), opts.str());
   const auto density = cl.build(with_prelude({"density.cl"}), opts.str());
   const auto forces = cl.build(with_prelude({"forces.cl"}), opts.str());
   const auto integrate = cl.build(with_prelude({"integrate.cl", "step_limits.cl"}), opts.str());
-  heat_ = scene.heat.enabled;
   if (heat_) {
     std::string heat_opts = opts.str() + " -DTHAW_EXPOSED_AREA=" + scene.heat.exposed_area;
+    if (plan.ambient) heat_opts += " -DTHAW_AMBIENT";
+    if (plan.dryers) heat_opts += " -DTHAW_DRYERS";
+    if (plan.walls) heat_opts += " -DTHAW_WALL_HEAT";
+    if (plan.lamps) heat_opts += " -DTHAW_LAMPS";
     for (int a = 0; a < 3; ++a)
       if (scene.solver.periodic[static_cast<std::size_t>(a)])
         heat_opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
@@ -266,7 +272,6 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   k_scan_ = cl::Kernel(grid, "radix_scan_rows");
   k_scatter_ = cl::Kernel(grid, "radix_scatter");
   k_starts_ = cl::Kernel(grid, "cell_starts");
-  k_reorder_ = cl::Kernel(grid, "reorder");
   k_psi_ = cl::Kernel(boundary, "boundary_psi");
   k_set_mass_ = cl::Kernel(boundary, "set_mass");
   k_density_ = cl::Kernel(density, "density");
@@ -279,12 +284,17 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   auto buf = [&](std::size_t bytes) {
     return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
   };
-  position_ = buf(n * 16);
-  velocity_ = buf(n * 16);
-  density_ = buf(n * 4);
-  phase_ = buf(n);
-  material_ = buf(n);
-  id_ = buf(n * 4);
+  // Per-particle fields: the core ones, then each stage's (heat's enthalpy, rigid ice's bodies).
+  for (const FieldSpec& f : core_fields()) {
+    const ParticleStore::Field h = store_.add(f);
+    if (f.name == "position") f_.position = h;
+    if (f.name == "velocity") f_.velocity = h;
+    if (f.name == "density") f_.density = h;
+    if (f.name == "phase") f_.phase = h;
+    if (f.name == "material") f_.material = h;
+    if (f.name == "id") f_.id = h;
+  }
+  if (heat_) f_.enthalpy = store_.add({"enthalpy", FieldType::Float32, 2});
   state_ = buf(n * 16);
   accel_ = buf(n * 16);
   for (int i = 0; i < 2; ++i) {
@@ -293,48 +303,38 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   }
   hist_ = buf((std::size_t(1) << radix_bits_) * std::max<std::uint32_t>(ntiles_, 1) * 4);
   totals_ = buf((std::size_t(1) << radix_bits_) * 4);
-  spare_pos_ = buf(n * 16);
-  spare_vel_ = buf(n * 16);
-  spare1f_ = buf(n * 4);
-  spare_phase_ = buf(n);
-  spare_mat_ = buf(n);
-  spare_id_ = buf(n * 4);
+  scratch_ = buf(n * 4);
   soa_ = buf(std::size_t(stride_) * 7 * 4);
   derived_ = buf(std::size_t(stride_) * 3 * 4);
   // The padding past the last particle is read by masked lanes only; keep it finite anyway.
   cl.queue().enqueueFillBuffer(soa_, 0.0f, 0, std::size_t(stride_) * 7 * 4);
   cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(stride_) * 3 * 4);
-  enthalpy_ = buf(n * 8);
-  spare_enthalpy_ = buf(n * 8);
+  table_ = material_thermal_table(scene, k_.rest_density);
   if (heat_) {
-    table_ = material_thermal_table(scene, k_.rest_density);
     materials_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                             table_.size() * sizeof(MaterialThermal), table_.data());
     thermal_ = buf(std::size_t(stride_) * 3 * 4);
     cl.queue().enqueueFillBuffer(thermal_, 0.0f, 0, std::size_t(stride_) * 3 * 4);
-    lamp_energy_ = buf(n * 4);
-    cl.queue().enqueueFillBuffer(lamp_energy_, 0.0f, 0, n * 4);
-    hits_ = buf(n * 4);
-    cl.queue().enqueueFillBuffer(hits_, cl_uint(0), 0, n * 4);
+    if (plan.lamps) {
+      lamp_energy_ = buf(n * 4);
+      cl.queue().enqueueFillBuffer(lamp_energy_, 0.0f, 0, n * 4);
+    }
     budget_parts_ = buf(std::size_t(stride_) * 5 * 4);
     budget_tiles_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 5 * 4);
     budget_bad_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 4);
     phase_changed_ = buf(4);
     cl.queue().enqueueFillBuffer(phase_changed_, cl_uint(0), 0, 4);
     dryers_ = buf(std::max<std::size_t>(scene.dryers.size(), 1) * sizeof(dryer::DryerJet));
-    if (!scene.lamps.empty()) {
-      // Voxels of one spacing over every particle: a lattice of that spacing puts one particle in each,
-      // at the centre for the lattice through the lowest particle (not on a face, where rounding could
-      // put two in one voxel and leave a hole next to it).
-      VoxelGridInfo vg;
-      vg.cell = static_cast<float>(scene.spacing);
-      vg.origin = lo - Eigen::Vector3f::Constant(1.5f * vg.cell);
-      const Eigen::Vector3f span = hi + Eigen::Vector3f::Constant(vg.cell) - vg.origin;
-      vg.nx = static_cast<int>(std::ceil(span.x() / vg.cell)) + 1;
-      vg.ny = static_cast<int>(std::ceil(span.y() / vg.cell)) + 1;
-      vg.nz = static_cast<int>(std::ceil(span.z() / vg.cell)) + 1;
-      photons_ = std::make_unique<PhotonTracer>(cl, vg);
-    }
+    // Voxels of one spacing over every particle: a lattice of that spacing puts one particle in each,
+    // at the centre for the lattice through the lowest particle (not on a face, where rounding could
+    // put two in one voxel and leave a hole next to it). Built once a lamp is on (start_photons).
+    photon_grid_.cell = static_cast<float>(scene.spacing);
+    photon_grid_.origin = lo - Eigen::Vector3f::Constant(1.5f * photon_grid_.cell);
+    const Eigen::Vector3f span = hi + Eigen::Vector3f::Constant(photon_grid_.cell) - photon_grid_.origin;
+    photon_grid_.nx = static_cast<int>(std::ceil(span.x() / photon_grid_.cell)) + 1;
+    photon_grid_.ny = static_cast<int>(std::ceil(span.y() / photon_grid_.cell)) + 1;
+    photon_grid_.nz = static_cast<int>(std::ceil(span.z() / photon_grid_.cell)) + 1;
+    start_photons();
   }
   cell_start_ = buf((std::size_t(ncells_) + 1) * 4);
   clamped_ = buf(4);
@@ -354,50 +354,52 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
       psi_unknown = true;
       init.position[i][3] = lattice_psi;
     }
-  upload(init);
-  if (psi_unknown && scene.solver.boundary_volume == "akinci") compute_boundary_psi();
-  if (heat_) {
-    if (!st.energy_budget.empty()) {
-      budget_ = EnergyBudget::from_vector(st.energy_budget);
-    } else {
-      budget_ = EnergyBudget{};
-      budget_.initial = total_enthalpy();
-    }
-  }
   const bool free_ice = std::any_of(scene.ice.begin(), scene.ice.end(),
                                     [](const IceBlock& b) { return b.motion == IceBlock::Motion::Free; });
   if (free_ice && scene.solver.flow) {
     std::vector<std::uint8_t> anchored_by_id(n_, 0);
     for (std::size_t i = 0; i < n_ && i < p.anchored.size(); ++i)
       if (p.id[i] < n_) anchored_by_id[p.id[i]] = p.anchored[i];
-    rigid_ = std::make_unique<RigidIce>(cl, opts.str(), n_, rigid_settings(scene, k_),
+    rigid_ = std::make_unique<RigidIce>(cl, store_, opts.str(), n_, rigid_settings(scene, k_),
                                         std::move(anchored_by_id), rigid_mass_scales(scene, k_.rest_density));
-    if (!st.rigid_body.empty())
-      rigid_->restore({st.rigid_body, st.rigid_offset, st.rigid_bodies, st.rigid_labelling}, n_);
+  }
+  // Every stage has declared its fields: allocate them and upload the state (a field the state lacks
+  // starts at its declared fill).
+  store_.allocate(n_);
+  upload(init);
+  if (rigid_ && !st.rigid_bodies.empty()) {
+    if (!p.column("body") || !p.column("body_offset"))
+      throw Error("state: rigid ice bodies without each particle's body and body_offset");
+    rigid_->restore({st.rigid_bodies, st.rigid_labelling});
+  }
+  if (psi_unknown && scene.solver.boundary_volume == "akinci") compute_boundary_psi();
+  if (!st.energy_budget.empty()) {
+    budget_ = EnergyBudget::from_vector(st.energy_budget);
+  } else {
+    budget_ = EnergyBudget{};
+    budget_.initial = total_enthalpy();
   }
 }
 
 Solver::~Solver() = default;
 
 ParticleBuffers Solver::buffers() const {
-  return {position_,   velocity_,      state_,
-          phase_,      material_,      id_,
-          cell_start_, cl_grid(grid_), static_cast<std::uint32_t>(n_)};
+  return {store_[f_.position], store_[f_.velocity], state_,
+          store_[f_.phase],    store_[f_.material], store_[f_.id],
+          cell_start_,         cl_grid(grid_),      static_cast<std::uint32_t>(n_)};
 }
 
 void Solver::upload(const HostParticles& p) {
   auto& q = cl_.queue();
   if (n_ == 0) return;
-  q.enqueueWriteBuffer(position_, CL_TRUE, 0, n_ * 16, p.position.data());
-  q.enqueueWriteBuffer(velocity_, CL_TRUE, 0, n_ * 16, p.velocity.data());
-  q.enqueueWriteBuffer(density_, CL_TRUE, 0, n_ * 4, p.density.data());
-  q.enqueueWriteBuffer(phase_, CL_TRUE, 0, n_, p.phase.data());
-  q.enqueueWriteBuffer(material_, CL_TRUE, 0, n_, p.material.data());
-  q.enqueueWriteBuffer(id_, CL_TRUE, 0, n_ * 4, p.id.data());
-  if (p.enthalpy.size() == n_) {
-    q.enqueueWriteBuffer(enthalpy_, CL_TRUE, 0, n_ * 8, p.enthalpy.data());
-  } else {
-    q.enqueueFillBuffer(enthalpy_, 0.0f, 0, n_ * 8);
+  store_.upload(p);
+  if (!heat_) {
+    std::vector<Float2> enthalpy = p.enthalpy;
+    enthalpy.resize(n_, Float2{0.f, 0.f});
+    // Without heat a particle's enthalpy never changes: the host keeps it by id, unsorted.
+    const std::uint32_t ids = n_ ? *std::max_element(p.id.begin(), p.id.end()) + 1 : 0;
+    fixed_enthalpy_.assign(ids, Float2{0.f, 0.f});
+    for (std::size_t i = 0; i < n_; ++i) fixed_enthalpy_[p.id[i]] = enthalpy[i];
   }
   const cl_uint zero = 0;
   q.enqueueWriteBuffer(clamped_, CL_TRUE, 0, 4, &zero);
@@ -419,7 +421,8 @@ void Solver::build_grid() {
   const auto& d = scene_.domain;
   const cl_float4 dmin{{float(d.min.x()), float(d.min.y()), float(d.min.z()), 0.f}};
   const cl_float4 dmax{{float(d.max.x()), float(d.max.y()), float(d.max.z()), 0.f}};
-  set_args(k_cell_keys_, position_, velocity_, phase_, keys_[0], order_[0], clamped_, g, dmin, dmax, n);
+  set_args(k_cell_keys_, store_[f_.position], store_[f_.velocity], store_[f_.phase], keys_[0], order_[0],
+           clamped_, g, dmin, dmax, n);
   launch(q, k_cell_keys_, n_);
 
   for (std::uint32_t pass = 0; pass < sort_passes_; ++pass) {
@@ -436,19 +439,8 @@ void Solver::build_grid() {
   const cl::Buffer& keys = keys_[sort_passes_ % 2];
   const cl::Buffer& order = order_[sort_passes_ % 2];
 
-  // Every per-particle state buffer follows the sort (a new buffer must be added here and to the
-  // reorder kernel), in one pass.
-  set_args(k_reorder_, order, n, position_, spare_pos_, velocity_, spare_vel_, density_, spare1f_, phase_,
-           spare_phase_, material_, spare_mat_, id_, spare_id_, enthalpy_, spare_enthalpy_, soa_, stride_);
-  launch(q, k_reorder_, n_);
-  std::swap(enthalpy_, spare_enthalpy_);
-  std::swap(position_, spare_pos_);
-  std::swap(velocity_, spare_vel_);
-  std::swap(density_, spare1f_);
-  std::swap(phase_, spare_phase_);
-  std::swap(material_, spare_mat_);
-  std::swap(id_, spare_id_);
-  if (rigid_) rigid_->reorder(order, n);
+  // Every declared field follows the sort in one pass (sim/particle_store.h).
+  store_.reorder(order, soa_, stride_);
 
   set_args(k_starts_, keys, cell_start_, n, ncells_);
   launch(q, k_starts_, n_ + 1);
@@ -460,9 +452,10 @@ void Solver::compute_boundary_psi() {
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(n_);
   const ClGrid g = cl_grid(grid_);
-  set_args(k_psi_, position_, phase_, cell_start_, g, k_.support, k_.rest_density, spare1f_, n);
+  set_args(k_psi_, store_[f_.position], store_[f_.phase], cell_start_, g, k_.support, k_.rest_density,
+           scratch_, n);
   launch(q, k_psi_, n_);
-  set_args(k_set_mass_, position_, spare1f_, n);
+  set_args(k_set_mass_, store_[f_.position], scratch_, n);
   launch(q, k_set_mass_, n_);
   q.finish();
 }
@@ -471,9 +464,9 @@ void Solver::compute_density() {
   if (n_ == 0) return;
   const ClGrid g = cl_grid(grid_);
   const auto& s = scene_.solver;
-  set_args(k_density_, position_, soa_, stride_, phase_, cell_start_, g, k_.support, k_.rest_density,
-           k_.stiffness, static_cast<float>(s.gamma), k_.visc_fluid, k_.visc_boundary, density_, state_,
-           derived_, static_cast<cl_uint>(n_));
+  set_args(k_density_, store_[f_.position], soa_, stride_, store_[f_.phase], cell_start_, g, k_.support,
+           k_.rest_density, k_.stiffness, static_cast<float>(s.gamma), k_.visc_fluid, k_.visc_boundary,
+           store_[f_.density], state_, derived_, static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_density_, n_);
 }
 
@@ -483,9 +476,9 @@ void Solver::compute_forces() {
   const float h = k_.smoothing;
   const cl_float4 gravity{
       {float(scene_.gravity.x()), float(scene_.gravity.y()), float(scene_.gravity.z()), 0.f}};
-  set_args(k_forces_, position_, velocity_, soa_, derived_, stride_, state_, phase_, cell_start_, g,
-           k_.support, gravity, 0.01f * h * h, k_.rest_density, k_.repulsion, k_.repulsion_range,
-           k_.repulsion_damping, accel_, static_cast<cl_uint>(n_));
+  set_args(k_forces_, store_[f_.position], store_[f_.velocity], soa_, derived_, stride_, state_,
+           store_[f_.phase], cell_start_, g, k_.support, gravity, 0.01f * h * h, k_.rest_density,
+           k_.repulsion, k_.repulsion_range, k_.repulsion_damping, accel_, static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_forces_, n_);
 }
 
@@ -516,8 +509,8 @@ double Solver::choose_time_step() {
   double vmax2 = 0, amax2 = 0;
   std::uint32_t fastest = 0, bad = 0xffffffffu;
   if (n_ > 0) {
-    set_args(k_limits_, position_, velocity_, accel_, phase_, limits_f_, limits_i_, static_cast<cl_uint>(n_),
-             tile_);
+    set_args(k_limits_, store_[f_.position], store_[f_.velocity], accel_, store_[f_.phase], limits_f_,
+             limits_i_, static_cast<cl_uint>(n_), tile_);
     cl_.queue().enqueueNDRangeKernel(k_limits_, cl::NullRange, global_for(ntiles_));
     std::vector<cl_float2> f(ntiles_);
     std::vector<cl_uint2> ix(ntiles_);
@@ -535,9 +528,9 @@ double Solver::choose_time_step() {
   auto particle_at = [&](std::uint32_t i) {
     Float4 x, v;
     std::uint32_t id = 0;
-    cl_.queue().enqueueReadBuffer(position_, CL_TRUE, i * 16, 16, x.data());
-    cl_.queue().enqueueReadBuffer(velocity_, CL_TRUE, i * 16, 16, v.data());
-    cl_.queue().enqueueReadBuffer(id_, CL_TRUE, i * 4, 4, &id);
+    cl_.queue().enqueueReadBuffer(store_[f_.position], CL_TRUE, i * 16, 16, x.data());
+    cl_.queue().enqueueReadBuffer(store_[f_.velocity], CL_TRUE, i * 16, 16, v.data());
+    cl_.queue().enqueueReadBuffer(store_[f_.id], CL_TRUE, i * 4, 4, &id);
     std::ostringstream os;
     os << "particle " << id << " at (" << x[0] << ", " << x[1] << ", " << x[2] << ") m with velocity ("
        << v[0] << ", " << v[1] << ", " << v[2] << ") m/s";
@@ -589,7 +582,7 @@ double Solver::choose_time_step() {
 
 void Solver::trace_photons(double dt) {
   if (!photons_ || n_ == 0) return;
-  photons_->build_occupancy(position_, phase_, static_cast<std::uint32_t>(n_));
+  photons_->build_occupancy(store_[f_.position], store_[f_.phase], static_cast<std::uint32_t>(n_));
   for (std::size_t l = 0; l < scene_.lamps.size(); ++l) {
     const Lamp& lamp = scene_.lamps[l];
     if (!lamp.on) continue;
@@ -642,8 +635,9 @@ void Solver::compute_heat(double dt) {
   if (!heat_ || n_ == 0) return;
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(n_);
-  set_args(k_thermal_state_, position_, density_, enthalpy_, phase_, material_, materials_, k_.rest_density,
-           static_cast<cl_int>(scene_.solver.flow ? 1 : 0), thermal_, stride_, n);
+  set_args(k_thermal_state_, store_[f_.position], store_[f_.density], store_[f_.enthalpy], store_[f_.phase],
+           store_[f_.material], materials_, k_.rest_density, static_cast<cl_int>(scene_.solver.flow ? 1 : 0),
+           thermal_, stride_, n);
   launch(q, k_thermal_state_, n_);
   if (dryers_dirty_) upload_dryers();
   const ClGrid g = cl_grid(grid_);
@@ -656,14 +650,14 @@ void Solver::compute_heat(double dt) {
   // Iwasaki's voxel faces: a neighbour within 1.2 spacings covers one (lattice face neighbours sit at
   // 1, edge neighbours at 1.41 spacings).
   const float exposed_r2 = 1.44f * dx * dx;
-  set_args(k_heat_, position_, velocity_, enthalpy_, phase_, material_, materials_, soa_, thermal_, stride_,
-           cell_start_, g, k_.support, 0.01f * h * h, period, exposed_r2, dx * dx,
-           static_cast<float>(scene_.heat.ambient_temperature),
+  set_args(k_heat_, store_[f_.position], store_[f_.velocity], store_[f_.enthalpy], store_[f_.phase],
+           store_[f_.material], materials_, soa_, thermal_, stride_, cell_start_, g, k_.support,
+           0.01f * h * h, period, exposed_r2, dx * dx, static_cast<float>(scene_.heat.ambient_temperature),
            static_cast<float>(scene_.heat.ambient_coefficient), dryers_,
-           static_cast<cl_uint>(scene_.dryers.size()), lamp_energy_,
+           static_cast<cl_uint>(scene_.dryers.size()), lamp_energy_() ? lamp_energy_ : dryers_,
            static_cast<float>(scene_.heat.time_scale * dt), budget_parts_, phase_changed_, n);
   launch(q, k_heat_, n_);
-  set_args(k_heat_budget_, budget_parts_, enthalpy_, stride_, budget_tiles_, budget_bad_, n, tile_);
+  set_args(k_heat_budget_, budget_parts_, store_[f_.enthalpy], stride_, budget_tiles_, budget_bad_, n, tile_);
   q.enqueueNDRangeKernel(k_heat_budget_, cl::NullRange, global_for(ntiles_));
   std::vector<float> sums(std::size_t(ntiles_) * 5);
   std::vector<cl_uint> bad(ntiles_);
@@ -676,8 +670,8 @@ void Solver::compute_heat(double dt) {
     if (bad[t] != 0xffffffffu) {
       Float4 x;
       std::uint32_t id = 0;
-      q.enqueueReadBuffer(position_, CL_TRUE, bad[t] * 16, 16, x.data());
-      q.enqueueReadBuffer(id_, CL_TRUE, bad[t] * 4, 4, &id);
+      q.enqueueReadBuffer(store_[f_.position], CL_TRUE, bad[t] * 16, 16, x.data());
+      q.enqueueReadBuffer(store_[f_.id], CL_TRUE, bad[t] * 4, 4, &id);
       std::ostringstream os;
       os << "step " << steps_ + 1 << " (t = " << time_ << " s): particle " << id << " at (" << x[0] << ", "
          << x[1] << ", " << x[2]
@@ -712,8 +706,8 @@ std::vector<Float4> Solver::ice_forces() const {
 
 void Solver::integrate(double dt) {
   if (n_ == 0) return;
-  set_args(k_integrate_, position_, velocity_, accel_, phase_, static_cast<float>(dt),
-           static_cast<float>(1.0 / (1.0 + damping_ * dt)), static_cast<cl_uint>(n_));
+  set_args(k_integrate_, store_[f_.position], store_[f_.velocity], accel_, store_[f_.phase],
+           static_cast<float>(dt), static_cast<float>(1.0 / (1.0 + damping_ * dt)), static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_integrate_, n_);
 }
 
@@ -799,6 +793,31 @@ void Solver::set_lamp(std::size_t index, const Lamp& l) {
   Lamp checked = l;
   checked.normal = unit_direction(l.normal, path + ".normal");
   scene_.lamps[index] = checked;
+  start_photons();
+}
+
+void Solver::start_photons() {
+  if (photons_ || !heat_) return;
+  if (std::none_of(scene_.lamps.begin(), scene_.lamps.end(), [](const Lamp& l) { return l.on; })) return;
+  const std::size_t n = std::max<std::size_t>(n_, 1);
+  hits_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, n * 4);
+  cl_.queue().enqueueFillBuffer(hits_, cl_uint(0), 0, n * 4);
+  photons_ = std::make_unique<PhotonTracer>(cl_, photon_grid_);
+}
+
+std::vector<std::string> Solver::stages() const {
+  const bool flow = scene_.solver.flow;
+  std::vector<std::string> out = {"grid"};
+  if (flow) out.insert(out.end(), {"density", "forces"});
+  if (rigid_) out.push_back("rigid ice");
+  out.push_back("time step");
+  if (heat_) {
+    out.push_back(photons_ ? "photons" : !scene_.lamps.empty() ? "photons (when a lamp is on)" : "");
+    out.push_back("heat (" + heat_reason_ + ")");
+  }
+  if (flow) out.push_back("integrate");
+  out.erase(std::remove(out.begin(), out.end(), std::string()), out.end());
+  return out;
 }
 
 Solver::ThermalInputs Solver::thermal_inputs() const {
@@ -813,7 +832,7 @@ Solver::ThermalInputs Solver::thermal_inputs() const {
 }
 
 double Solver::total_enthalpy() const {
-  if (!heat_ || n_ == 0) return 0.0;
+  if (n_ == 0) return 0.0;
   const HostParticles p = particles();
   double sum = 0;
   for (std::size_t i = 0; i < n_; ++i) {
@@ -824,8 +843,9 @@ double Solver::total_enthalpy() const {
 }
 
 std::vector<float> Solver::temperatures() const {
-  if (!heat_ || n_ == 0) return std::vector<float>(n_, 0.0f);
-  return temperatures_of(particles(), scene_);
+  std::vector<float> t = temperatures_of(particles(), scene_);
+  t.resize(n_, 0.0f);
+  return t;
 }
 
 std::uint64_t Solver::clamped() const {
@@ -836,16 +856,9 @@ std::uint64_t Solver::clamped() const {
 
 HostParticles Solver::particles() const {
   HostParticles p;
-  p.resize(n_);
-  if (n_ == 0) return p;
-  auto& q = cl_.queue();
-  q.enqueueReadBuffer(position_, CL_FALSE, 0, n_ * 16, p.position.data());
-  q.enqueueReadBuffer(velocity_, CL_FALSE, 0, n_ * 16, p.velocity.data());
-  q.enqueueReadBuffer(density_, CL_FALSE, 0, n_ * 4, p.density.data());
-  q.enqueueReadBuffer(phase_, CL_FALSE, 0, n_, p.phase.data());
-  q.enqueueReadBuffer(material_, CL_FALSE, 0, n_, p.material.data());
-  q.enqueueReadBuffer(enthalpy_, CL_FALSE, 0, n_ * 8, p.enthalpy.data());
-  q.enqueueReadBuffer(id_, CL_TRUE, 0, n_ * 4, p.id.data());
+  store_.download(p);
+  if (!heat_)
+    for (std::size_t i = 0; i < n_; ++i) p.enthalpy[i] = fixed_enthalpy_[p.id[i]];
   return p;
 }
 
@@ -857,11 +870,9 @@ SimState Solver::state() const {
   s.dt = dt_;
   s.clamped = clamped();
   s.scene_json = scene_.source.dump();
-  if (heat_) s.energy_budget = budget_.to_vector();
+  s.energy_budget = budget_.to_vector();
   if (rigid_) {
-    RigidIce::Saved r = rigid_->save(n_);
-    s.rigid_body = std::move(r.body);
-    s.rigid_offset = std::move(r.offset);
+    RigidIce::Saved r = rigid_->save();
     s.rigid_bodies = std::move(r.bodies);
     s.rigid_labelling = std::move(r.labelling);
   }
@@ -876,7 +887,7 @@ std::vector<std::uint32_t> Solver::cell_starts() const {
 
 std::vector<float> Solver::densities() const {
   std::vector<float> out(n_);
-  if (n_) cl_.queue().enqueueReadBuffer(density_, CL_TRUE, 0, n_ * 4, out.data());
+  if (n_) cl_.queue().enqueueReadBuffer(store_[f_.density], CL_TRUE, 0, n_ * 4, out.data());
   return out;
 }
 

@@ -11,7 +11,9 @@
 
 #include "sim/cl_runtime.h"
 #include "sim/kernels/thermal_law.h"
+#include "sim/particle_store.h"
 #include "sim/particles.h"
+#include "sim/photons.h"
 #include "sim/scene.h"
 #include "sim/stage_timers.h"
 #include "sim/state_file.h"
@@ -119,6 +121,12 @@ class Solver {
   void compute_ice_forces();
   std::vector<Float4> ice_forces() const;
 
+  // The stages this run built, in step order, e.g. {"grid", "density", "forces", "time step",
+  // "integrate"}; heat names why it was built ("heat (the scene has dryers)").
+  std::vector<std::string> stages() const;
+  // Why heat was or was not built (plan_heat in sim/thermal.h).
+  const std::string& heat_reason() const { return heat_reason_; }
+
   // Rigid ice (scenes with free ice; null otherwise): the bodies, labelling and its counters.
   const RigidIce* rigid_ice() const { return rigid_.get(); }
 
@@ -147,6 +155,7 @@ class Solver {
   ParticleBuffers buffers() const;
   void upload(const HostParticles& p);
   void upload_dryers();
+  void start_photons();  // builds the photon tracer once heat is built and a lamp is on
   double heat_time_step() const;
   template <class F>
   void timed(Stage s, F&& f);
@@ -166,28 +175,34 @@ class Solver {
   std::uint32_t tile_ = 256, ntiles_ = 0;  // particles per work-item in the sort and the time-step limits
   std::uint32_t stride_ = 0;  // length of each structure-of-arrays block: n rounded up, plus padding
 
-  // Per-particle state, reordered with the sort.
-  cl::Buffer position_, velocity_, density_, phase_, material_, id_;
+  // Per-particle state, one buffer per declared field, reordered with the sort (sim/particle_store.h).
+  ParticleStore store_;
+  struct Fields {
+    ParticleStore::Field position = 0, velocity = 0, density = 0, phase = 0, material = 0, id = 0,
+                         enthalpy = 0;
+  } f_;
   // Derived each step: pressure state, accelerations; the reorder's structure-of-arrays copy of
   // position, mass and velocity, and the density pass's pair coefficients (read by the forces pass).
   cl::Buffer state_, accel_, soa_, derived_;
-  // Scratch: sort keys/values (two of each), histogram, the reorder's targets, cell starts, limits.
-  cl::Buffer keys_[2], order_[2], hist_, totals_, spare_pos_, spare_vel_, spare1f_, spare_phase_, spare_mat_,
-      spare_id_, cell_start_;
+  // Scratch: sort keys/values (two of each), histogram, one float per particle, cell starts, limits.
+  cl::Buffer keys_[2], order_[2], hist_, totals_, scratch_, cell_start_;
   cl::Buffer clamped_, limits_f_, limits_i_;
 
-  cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_, k_reorder_;
+  cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_;
   cl::Kernel k_psi_, k_set_mass_, k_density_, k_forces_, k_limits_, k_integrate_;
 
-  // Heat (built only when scene.heat.enabled): enthalpy (hi, lo) per particle, reordered with the rest;
-  // the material table; T, k, V blocks for the neighbour loop; absorbed lamp energy; photon hits; the
-  // per-particle energies of the budget and their per-tile sums.
+  // Heat (built only when plan_heat says the scene needs it): enthalpy (hi, lo) per particle, reordered
+  // with the rest; the material table; T, k, V blocks for the neighbour loop; absorbed lamp energy;
+  // photon hits; the per-particle energies of the budget and their per-tile sums. Without heat the
+  // enthalpy never changes and stays on the host, by particle id (fixed_enthalpy_).
   bool heat_ = false;
+  std::string heat_reason_;
+  std::vector<Float2> fixed_enthalpy_;
+  VoxelGridInfo photon_grid_;
   bool grid_built_ = false;
   std::vector<thermal::MaterialThermal> table_;
   EnergyBudget budget_;
-  cl::Buffer enthalpy_, spare_enthalpy_, materials_, thermal_, lamp_energy_, hits_, budget_parts_,
-      budget_tiles_, budget_bad_, dryers_;
+  cl::Buffer materials_, thermal_, lamp_energy_, hits_, budget_parts_, budget_tiles_, budget_bad_, dryers_;
   bool dryers_dirty_ = true;
   std::unique_ptr<PhotonTracer> photons_;
   cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_heat_budget_;

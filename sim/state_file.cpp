@@ -30,6 +30,12 @@ constexpr std::uint32_t kByteOrderMark = 0x01020304;
 constexpr std::uint32_t kSectionRequired = 1;
 // A section of the run as a whole (its count is its own, not the particle count).
 constexpr std::uint32_t kSectionGlobal = 2;
+// A declared field's spec (sim/particle_fields.h) rides in the flags: bit 2 exported, bits 8-15 the
+// element type (FieldType; 0 in files written before fields were declared), bits 16-23 its width.
+constexpr std::uint32_t kSectionExported = 4;
+constexpr std::uint32_t field_flags(const FieldSpec& f) {
+  return (f.exported ? kSectionExported : 0u) | (std::uint32_t(f.type) << 8) | (std::uint32_t(f.width) << 16);
+}
 constexpr const char* kEnergySection = "energy_budget";
 constexpr const char* kBodiesSection = "rigid_bodies";
 constexpr const char* kLabellingSection = "rigid_labelling";
@@ -158,8 +164,13 @@ void for_each_array(Particles& p, Visit&& visit) {
 template <typename State, typename Visit>
 void for_each_optional_array(State& s, Visit&& visit) {
   visit("anchored", s.particles.anchored);
-  visit("body", s.rigid_body);
-  visit("body_offset", s.rigid_offset);
+}
+
+// Fields that files written before fields were declared hold without a type in their flags: rigid ice's.
+std::optional<FieldSpec> legacy_field(const std::string& name) {
+  if (name == "body") return FieldSpec{"body", FieldType::UInt32, 1, true, true, 0xffffffffu};
+  if (name == "body_offset") return FieldSpec{"body_offset", FieldType::Float32, 4};
+  return std::nullopt;
 }
 
 template <typename Array>
@@ -206,6 +217,11 @@ std::string encode_state(const SimState& s) {
     ++sections;
     body += 4 + std::strlen(name) + 4 + 4 + 8 + array.size() * sizeof(array[0]);
   });
+  for (const HostColumn& c : p.columns) {
+    if (!c.spec.saved) continue;
+    ++sections;
+    body += 4 + c.spec.name.size() + 4 + 4 + 8 + c.bytes.size();
+  }
   for_each_global(s, [&](const char* name, const std::vector<double>& values) {
     if (values.empty()) return;
     ++sections;
@@ -244,6 +260,15 @@ std::string encode_state(const SimState& s) {
   for_each_optional_array(s, [&](const char* name, const auto& array) {
     if (worth_writing(array, p.size())) write_array(name, array);
   });
+  for (const HostColumn& c : p.columns) {
+    if (!c.spec.saved) continue;
+    w.u32(static_cast<std::uint32_t>(c.spec.name.size()));
+    w.bytes(c.spec.name);
+    w.u32(kSectionRequired | field_flags(c.spec));
+    w.u32(static_cast<std::uint32_t>(c.spec.bytes()));
+    w.u64(c.size());
+    w.words(c.bytes.data(), c.bytes.size(), scalar_bytes(c.spec.type));
+  }
   for_each_global(s, [&](const char* name, const std::vector<double>& values) {
     if (values.empty()) return;
     const std::size_t name_length = std::strlen(name);
@@ -409,6 +434,31 @@ SimState decode_state(const std::string& path, std::string_view data) {
     };
     for_each_array(s.particles, read_array);
     for_each_optional_array(s, read_array);
+    // A declared field's column: its spec from the flags (or, in older files, from its name).
+    std::optional<FieldSpec> spec;
+    const auto type = static_cast<FieldType>((flags >> 8) & 0xff);
+    if (!known && !(flags & kSectionGlobal)) {
+      if (type == FieldType::Float32 || type == FieldType::UInt32 || type == FieldType::UInt8)
+        spec = FieldSpec{name, type, int((flags >> 16) & 0xff), true, (flags & kSectionExported) != 0};
+      else if (type == FieldType(0))
+        spec = legacy_field(name);
+    }
+    if (spec) {
+      if (spec->width != 1 && spec->width != 2 && spec->width != 4)
+        throw file_error(path, "section '" + name + "' declares a width of " + std::to_string(spec->width));
+      if (element_size != spec->bytes())
+        throw file_error(path, "section '" + name + "' has elements of " + std::to_string(element_size) +
+                                   " bytes, expected " + std::to_string(spec->bytes()));
+      if (count != n)
+        throw file_error(path, "array sizes inconsistent: section '" + name + "' has " +
+                                   std::to_string(count) + " elements, header says " + std::to_string(n) +
+                                   " particles");
+      HostColumn c{*spec, std::vector<std::uint8_t>(payload.size())};
+      copy_little_endian(reinterpret_cast<char*>(c.bytes.data()), payload.data(), payload.size(),
+                         scalar_bytes(spec->type));
+      s.particles.columns.push_back(std::move(c));
+      known = true;
+    }
     if (!known && (flags & kSectionRequired)) {
       throw file_error(path, "unknown required section '" + name +
                                  "' (written by a newer thaw; this build cannot resume it)");
@@ -546,8 +596,13 @@ void check_state(const SimState& s, const Scene& scene, const std::string& origi
     if (i < p.anchored.size() && p.anchored[i] > 1)
       refuse(where("anchored", i) + std::to_string(p.anchored[i]) + " is neither 0 nor 1");
   }
-  for (std::size_t i = 0; i < s.rigid_offset.size(); ++i)
-    if (!finite4(s.rigid_offset[i], 4)) refuse(where("body_offset", i) + "not finite");
+  for (const HostColumn& c : p.columns) {
+    if (c.spec.type != FieldType::Float32) continue;
+    const float* v = c.as<float>();
+    for (std::size_t k = 0; k < c.bytes.size() / 4; ++k)
+      if (!std::isfinite(v[k]))
+        refuse(where(c.spec.name.c_str(), k / std::size_t(c.spec.width)) + "not finite");
+  }
   const auto all_finite = [&](const std::vector<double>& v, const char* section) {
     for (std::size_t k = 0; k < v.size(); ++k)
       if (!std::isfinite(v[k]))

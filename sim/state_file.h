@@ -19,12 +19,15 @@
 //   header sum     u64      FNV-1a-64 of every byte above
 //   scene JSON     bytes
 //   sections       each: name length u32, name, flags u32 (bit 0: required; bit 1: global, i.e. a
-//                  record of the run whose count is its own, not the particle count), element size u32,
+//                  record of the run whose count is its own, not the particle count; for a declared
+//                  field, bit 2: exported, bits 8-15: FieldType, bits 16-23: width), element size u32,
 //                  count u64, count * element size bytes. Per particle: position, velocity, density,
 //                  phase, material, id, enthalpy (two floats: hi, lo); where present, anchored (u8:
-//                  particles of fixed ice objects), body (u32) and body_offset (four floats) of runs
-//                  with free ice. Global: energy_budget (doubles, only in runs with heat),
-//                  rigid_bodies and rigid_labelling (doubles, only in runs with free ice).
+//                  particles of fixed ice objects); then every field a stage declared
+//                  (HostParticles::columns, e.g. body (u32) and body_offset (four floats) of runs with
+//                  free ice; files written before the type bits existed hold those two untyped).
+//                  Global: energy_budget (doubles), rigid_bodies and rigid_labelling (doubles, only in
+//                  runs with free ice).
 //   checksum       u64      FNV-1a-64 of every byte before it
 // Arrays are named sections so later versions can add per-particle fields (temperature, enthalpy,
 // body id) without breaking readers: a reader skips unknown optional sections and refuses unknown
@@ -47,14 +50,11 @@ struct SimState {
   double dt = 0.0;            // last time step [s]
   std::uint64_t clamped = 0;  // particles clamped back into the domain so far
   std::string scene_json;     // the resolved scene document the run used
-  // The run's energy account [J] (sim/solver.h, EnergyBudget::to_vector); empty without heat. Stored as
+  // The run's energy account [J] (sim/solver.h, EnergyBudget::to_vector). Stored as
   // the section "energy_budget" (flags: required, global), whose count is its own.
   std::vector<double> energy_budget;
-  // Rigid ice (sim/rigid_ice.h), in runs with free ice only: per particle in the same order as
-  // `particles`, the body index and the body-frame offset (sections "body", "body_offset"), and the
-  // bodies with their labelling schedule (global section "rigid_bodies"). Empty otherwise.
-  std::vector<std::uint32_t> rigid_body;
-  std::vector<Float4> rigid_offset;
+  // Rigid ice (sim/rigid_ice.h), in runs with free ice only: the bodies with their labelling schedule
+  // (global section "rigid_bodies"); each particle's body and offset are fields (particles.columns).
   std::vector<double> rigid_bodies;
   // The last labelling's record (global section "rigid_labelling"): its sweeps, then each body's shape,
   // its particle count and their body-frame offsets, which keep it inside the domain. Files written

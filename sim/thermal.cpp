@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "sim/solver.h"
 
@@ -98,6 +99,51 @@ std::vector<float> temperatures_of(const HostParticles& p, const Scene& scene) {
     out.push_back(static_cast<float>(
         temperature_at(table[p.material[i]], double(p.enthalpy[i][0]) + double(p.enthalpy[i][1]))));
   return out;
+}
+
+HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
+  HeatPlan plan;
+  if (!scene.heat.enabled) {
+    plan.reason = "heat.enabled is false";
+    return plan;
+  }
+  plan.dryers = !scene.dryers.empty();
+  plan.lamps = !scene.lamps.empty();
+  const bool wall_heat = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                     [](const Material& m) { return m.wall_heat; });
+  plan.walls = wall_heat && scene.heat.wall_coefficient > 0;
+  plan.ambient = scene.heat.ambient_coefficient > 0;
+
+  // Temperatures differ by round-off only when each came from the same temperature through a float
+  // enthalpy pair: a thousandth of a millikelvin is no difference.
+  constexpr double kSame = 1e-6;
+  const std::vector<float> T = temperatures_of(p, scene);
+  const auto [lo, hi] = std::minmax_element(T.begin(), T.end());
+  const bool spread = !T.empty() && double(*hi) - double(*lo) > kSame;
+  auto differs = [&](double outside) {
+    return !T.empty() && (std::abs(double(*lo) - outside) > kSame || std::abs(double(*hi) - outside) > kSame);
+  };
+  std::ostringstream why;
+  if (plan.dryers) {
+    why << "the scene has dryers";
+  } else if (plan.lamps) {
+    why << "the scene has lamps";
+  } else if (spread) {
+    why << "temperatures range from " << *lo << " to " << *hi << " °C";
+  } else if (plan.ambient && differs(scene.heat.ambient_temperature)) {
+    why << "the ambient air is at " << scene.heat.ambient_temperature << " °C";
+  } else if (plan.walls && differs(scene.heat.wall_temperature)) {
+    why << "the tank walls' outside is at " << scene.heat.wall_temperature << " °C";
+  } else {
+    why << "no heat: every particle is at " << (T.empty() ? 0.0 : double(*lo))
+        << " °C and nothing heats or cools it";
+    plan.reason = why.str();
+    plan.ambient = plan.walls = false;
+    return plan;
+  }
+  plan.build = true;
+  plan.reason = why.str();
+  return plan;
 }
 
 double max_diffusivity(const Scene& scene) {

@@ -1,6 +1,7 @@
 #pragma once
 // The host side of the heat model: each material's thermal law for the device (sim/kernels/thermal_law.h),
 // and conversions between temperature and the enthalpy a particle carries.
+#include <string>
 #include <vector>
 
 #include "sim/kernels/thermal_law.h"
@@ -35,6 +36,21 @@ std::vector<float> temperatures_of(const HostParticles& p, const Scene& scene);
 // Thermal diffusivity k / (rho c) of the most diffusive material [m^2/s] that some particle has or can
 // turn into (held solids excepted): it sets the diffusion time-step limit.
 double max_diffusivity(const Scene& scene);
+
+// Which parts of the heat stage a run builds. Heat is built only when something can make temperatures
+// differ or change: particles at different temperatures, air or tank walls at another temperature than
+// the particles they touch, or a heat source a user may switch on during the run (a dryer or a lamp, on
+// or off). Each source is compiled into the heat pass only when the scene has it. An isothermal scene
+// (a dam break at 20 °C in 20 °C air) builds no heat at all: no enthalpy sort, no heat pass, no read-back.
+struct HeatPlan {
+  bool build = false;    // the heat stage at all
+  bool ambient = false;  // exchange with the ambient air (heat.ambient_coefficient > 0)
+  bool dryers = false;   // the scene has dryers
+  bool walls = false;    // tank walls exchange heat with the outside (heat.wall_coefficient > 0)
+  bool lamps = false;    // the scene has lamps (the photon grid is built once one is on)
+  std::string reason;    // why heat is built or not, in words, for `thaw run`'s list of stages
+};
+HeatPlan plan_heat(const Scene& scene, const HostParticles& particles);
 
 // Kelvin offset of the Celsius scale, for radiation.
 inline constexpr double kKelvin = 273.15;

@@ -87,33 +87,3 @@ kernel void cell_starts(global const uint* keys, global uint* cell_start, const 
   const uint hi = i == n ? ncells : keys[i];
   for (uint k = lo; k <= hi; ++k) cell_start[k] = i;
 }
-
-/* The reorder: every per-particle state buffer gathered into sorted order in one pass, plus the
- * structure-of-arrays copy the neighbour loops read (x, y, z, m, vx, vy, vz blocks of `stride`
- * floats; see the SIMD lanes in grid_common.h). */
-kernel void reorder(global const uint* order, const uint n, global const float4* pos_in,
-                    global float4* pos_out, global const float4* vel_in, global float4* vel_out,
-                    global const float* rho_in, global float* rho_out, global const uchar* phase_in,
-                    global uchar* phase_out, global const uchar* material_in, global uchar* material_out,
-                    global const uint* id_in, global uint* id_out, global const float2* enthalpy_in,
-                    global float2* enthalpy_out, global float* soa, const uint stride) {
-  const uint i = get_global_id(0);
-  if (i >= n) return;
-  const uint s = order[i];
-  const float4 p = pos_in[s];
-  const float4 v = vel_in[s];
-  pos_out[i] = p;
-  vel_out[i] = v;
-  rho_out[i] = rho_in[s];
-  phase_out[i] = phase_in[s];
-  material_out[i] = material_in[s];
-  id_out[i] = id_in[s];
-  enthalpy_out[i] = enthalpy_in[s];
-  soa[i] = p.x;
-  soa[stride + i] = p.y;
-  soa[2 * stride + i] = p.z;
-  soa[3 * stride + i] = p.w;
-  soa[4 * stride + i] = v.x;
-  soa[5 * stride + i] = v.y;
-  soa[6 * stride + i] = v.z;
-}

@@ -156,29 +156,48 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
       const floatV term = vloadV(0, VV + j) * kij * (Ti - vloadV(0, TT + j)) * grad_shape(sqrt(r2) * inv_H) *
                           r2 / (r2 + eta2);
       acc += select((floatV)(0.0f), term, in);
+#if defined(THAW_AMBIENT) || defined(THAW_DRYERS)
       covered += select((intV)(0), (intV)(1), lane & (r2 < exposed_r2));
+#endif
     }
   })
   /* x . grad W = sigma / H^2 grad_shape(q) r^2 (sph_lanes.h). */
   const float Vi = VV[i];
   const float q_conduction = 2.0f * Vi * THAW_SIGMA(H) * inv_H * inv_H * lanes_sum(acc);
+#if defined(THAW_AMBIENT) || defined(THAW_DRYERS)
   int neighbours = -1; /* the particle itself is in its own range */
   for (int l = 0; l < THAW_VW; ++l) neighbours += ((int*)&covered)[l];
+#endif
 
   const uchar mi = material[i];
   const MaterialThermal m = materials[mi];
-  const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? THAW_EXPOSED_FN(neighbours, face_area) : 0.0f;
+  /* Each source is compiled in only when the scene has it (Solver: THAW_AMBIENT with an ambient
+   * coefficient above 0, THAW_DRYERS with dryers, THAW_WALL_HEAT with walls that exchange heat with the
+   * outside, THAW_LAMPS with lamps), so a scene without them tests no flag per particle. */
   float q_ambient = 0.0f, q_dryers = 0.0f, q_walls = 0.0f;
+#if defined(THAW_AMBIENT) || defined(THAW_DRYERS)
+  const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? THAW_EXPOSED_FN(neighbours, face_area) : 0.0f;
   if (exposed > 0.0f) {
+#ifdef THAW_AMBIENT
     q_ambient = ambient_coefficient * (ambient_temperature - Ti) * exposed;
+#endif
+#ifdef THAW_DRYERS
     for (uint d = 0; d < ndryers; ++d) {
       const float2 air = dryer_air(dryers[d], pi.x, pi.y, pi.z, ambient_temperature);
       q_dryers += air.x * (air.y - Ti) * exposed;
     }
+#endif
   }
+#endif
+#ifdef THAW_WALL_HEAT
   if (m.flags & THAW_MAT_WALL_HEAT) q_walls = m.wall_coefficient * (m.wall_temperature - Ti);
+#endif
+#ifdef THAW_LAMPS
   const float e_lamps = lamp_energy[i];
   lamp_energy[i] = 0.0f;
+#else
+  const float e_lamps = 0.0f;
+#endif
 
   const float mass = pi.w * m.thermal_mass_scale;
   const float e_ambient = q_ambient * dt_heat, e_dryers = q_dryers * dt_heat, e_walls = q_walls * dt_heat;

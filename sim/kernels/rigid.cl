@@ -103,13 +103,3 @@ kernel void rigid_place(global float4* pos, global float4* vel, global const uch
   pos[i] = (float4)(B.centre.xyz + r, pos[i].w);
   vel[i] = (float4)(B.velocity.xyz + cross(B.omega.xyz, r), 0.0f);
 }
-
-/* The body index and body-frame offset of each particle follow the neighbour sort (grid.cl's reorder). */
-kernel void rigid_reorder(global const uint* order, const uint n, global const uint* body_in, global uint* body_out,
-                          global const float4* offset_in, global float4* offset_out) {
-  const uint i = get_global_id(0);
-  if (i >= n) return;
-  const uint s = order[i];
-  body_out[i] = body_in[s];
-  offset_out[i] = offset_in[s];
-}

@@ -1,6 +1,7 @@
 // Heat and phase change: energy accounting, the sources, runtime controls, stress, scene errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "sim/error.h"
@@ -49,8 +50,9 @@ class HeatTest : public ClSuite {};
 // ice at 0 °C. The total enthalpy is conserved to round-off while particles change phase both ways.
 TEST_F(HeatTest, EnergyIsConservedThroughPhaseChangeBothWays) {
   Json doc = isolated_scene();
-  doc["ice"] = {{{"material", "ice"}, {"box", box(0, 0, 0, 0.024, 0.04, 0.04)}, {"temperature", -60}},
-                {{"material", "ice"}, {"box", box(0.064, 0.012, 0.012, 0.072, 0.028, 0.028)}, {"temperature", 0}}};
+  doc["ice"] = {
+      {{"material", "ice"}, {"box", box(0, 0, 0, 0.024, 0.04, 0.04)}, {"temperature", -60}},
+      {{"material", "ice"}, {"box", box(0.064, 0.012, 0.012, 0.072, 0.028, 0.028)}, {"temperature", 0}}};
   doc["fluids"] = {{{"material", "water"}, {"box", box(0.024, 0, 0, 0.032, 0.04, 0.04)}, {"temperature", 1}},
                    {{"material", "water"}, {"box", box(0.048, 0, 0, 0.08, 0.04, 0.04)}, {"temperature", 80}}};
   const Scene scene = scene_from_json(doc);
@@ -59,7 +61,9 @@ TEST_F(HeatTest, EnergyIsConservedThroughPhaseChangeBothWays) {
     const HostParticles p = s.particles();
     int n = 0;
     for (std::size_t i = 0; i < p.size(); ++i)
-      if (p.phase[i] == static_cast<std::uint8_t>(Phase::Ice) && p.position[i][0] > x0 && p.position[i][0] < x1) ++n;
+      if (p.phase[i] == static_cast<std::uint8_t>(Phase::Ice) && p.position[i][0] > x0 &&
+          p.position[i][0] < x1)
+        ++n;
     return n;
   };
   const int frozen0 = ice_in(0, 0.04), melting0 = ice_in(0.04, 0.08);
@@ -78,7 +82,8 @@ TEST_F(HeatTest, EnergyIsConservedThroughPhaseChangeBothWays) {
 
 Json warm_block_scene() {
   Json doc = isolated_scene();
-  doc["ice"] = {{{"material", "ice"}, {"box", box(0.02, 0.008, 0.008, 0.06, 0.032, 0.032)}, {"temperature", -5}}};
+  doc["ice"] = {
+      {{"material", "ice"}, {"box", box(0.02, 0.008, 0.008, 0.06, 0.032, 0.032)}, {"temperature", -5}}};
   doc["solver"]["max_dt"] = 0.05;
   return doc;
 }
@@ -107,8 +112,12 @@ TEST_F(HeatTest, AmbientAirWarmsTheExposedSurfaceOnly) {
 
 TEST_F(HeatTest, DryerSwitchedOffAddsNothingAndSwitchedOnHeats) {
   Json doc = warm_block_scene();
-  doc["dryers"] = {{{"on", false}, {"position", {0.04, 0.02, 0.039}}, {"direction", {0, 0, -1}}, {"temperature", 80},
-                    {"speed", 15}, {"half_angle", 30}}};
+  doc["dryers"] = {{{"on", false},
+                    {"position", {0.04, 0.02, 0.039}},
+                    {"direction", {0, 0, -1}},
+                    {"temperature", 80},
+                    {"speed", 15},
+                    {"half_angle", 30}}};
   const Scene scene = scene_from_json(doc);
   Solver s(cl(), scene, initial_state(scene));
   for (int k = 0; k < 20; ++k) s.step();
@@ -148,8 +157,13 @@ TEST_F(HeatTest, DryerControlsAreCheckedLikeTheScene) {
 
 Json lamp_scene(const Eigen::Vector3d& normal) {
   Json doc = warm_block_scene();
-  doc["lamps"] = {{{"centre", {0.04, 0.02, 0.038}}, {"normal", {normal.x(), normal.y(), normal.z()}}, {"width", 0.02},
-                   {"height", 0.02}, {"temperature", 500}, {"emissivity", 0.9}, {"photons", 20000}}};
+  doc["lamps"] = {{{"centre", {0.04, 0.02, 0.038}},
+                   {"normal", {normal.x(), normal.y(), normal.z()}},
+                   {"width", 0.02},
+                   {"height", 0.02},
+                   {"temperature", 500},
+                   {"emissivity", 0.9},
+                   {"photons", 20000}}};
   return doc;
 }
 
@@ -205,8 +219,11 @@ TEST_F(HeatTest, HeldSolidAndTankWallsAccountTheirHeat) {
   doc["domain"]["walls"] = {"-z"};
   doc["domain"]["wall_material"] = "steel";
   doc["domain"]["wall_heat"] = {{"coefficient", 200}, {"temperature", 10}};
-  doc["solids"] = {{{"shape", "box"}, {"material", "steel"}, {"box", box(0.0, 0.0, 0.0, 0.02, 0.04, 0.012)},
-                    {"temperature", 60}, {"hold_temperature", true}}};
+  doc["solids"] = {{{"shape", "box"},
+                    {"material", "steel"},
+                    {"box", box(0.0, 0.0, 0.0, 0.02, 0.04, 0.012)},
+                    {"temperature", 60},
+                    {"hold_temperature", true}}};
   const Scene scene = scene_from_json(doc);
   Solver s(cl(), scene, initial_state(scene));
   for (int k = 0; k < 30; ++k) s.step();
@@ -224,10 +241,15 @@ TEST_F(HeatTest, ExtremeSourcesStayFiniteAndAccounted) {
   doc["domain"]["walls"] = {"-x", "+x", "-y", "+y", "-z"};
   doc["domain"]["wall_material"] = "steel";
   doc["ice"][0]["temperature"] = -100;
-  doc["fluids"] = {{{"material", "water"}, {"box", box(0.0, 0.0, 0.0, 0.016, 0.04, 0.02)}, {"temperature", 99}}};
+  doc["fluids"] = {
+      {{"material", "water"}, {"box", box(0.0, 0.0, 0.0, 0.016, 0.04, 0.02)}, {"temperature", 99}}};
   doc["heat"] = {{"time_scale", 1000}};
-  doc["dryers"] = {{{"position", {0.04, 0.02, 0.039}}, {"direction", {0, 0, -1}}, {"temperature", 500}, {"speed", 100},
-                    {"half_angle", 60}, {"reach", 10}}};
+  doc["dryers"] = {{{"position", {0.04, 0.02, 0.039}},
+                    {"direction", {0, 0, -1}},
+                    {"temperature", 500},
+                    {"speed", 100},
+                    {"half_angle", 60},
+                    {"reach", 10}}};
   const Scene scene = scene_from_json(doc);
   Solver s(cl(), scene, initial_state(scene));
   for (int k = 0; k < 300; ++k) s.step();
@@ -242,6 +264,9 @@ TEST_F(HeatTest, ExtremeSourcesStayFiniteAndAccounted) {
 TEST_F(HeatTest, TimeStepRespectsTheDiffusionLimit) {
   Json doc = warm_block_scene();
   doc["solver"]["max_dt"] = 3600.0;
+  // Air warmer than the block, so heat is built at all (an isothermal block builds none: plan_heat);
+  // its exchange limit (0.5 rho c dx / 6 h = 63 s) is far above the diffusion limit tested here.
+  doc["ambient"] = {{"temperature", 25}, {"heat_transfer_coefficient", 10}};
   const Scene slow = scene_from_json(doc);
   doc["heat"] = {{"time_scale", 10}};
   const Scene fast = scene_from_json(doc);
@@ -253,8 +278,103 @@ TEST_F(HeatTest, TimeStepRespectsTheDiffusionLimit) {
   EXPECT_NEAR(b.dt(), a.dt() / 10, 1e-6 * a.dt());
 }
 
+bool has_stage(const Solver& s, const std::string& prefix) {
+  for (const std::string& stage : s.stages())
+    if (stage.starts_with(prefix)) return true;
+  return false;
+}
+
+// A block of water falling in a box, everything at 20 °C in 20 °C air: nothing can heat or cool it.
+Json isothermal_flow_scene() {
+  Json doc = isolated_scene();
+  doc["solver"] = {{"max_dt", 1e-3}};
+  doc["domain"]["walls"] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  doc["domain"]["wall_material"] = "steel";
+  doc["fluids"] = {{{"material", "water"}, {"box", box(0, 0, 0, 0.04, 0.04, 0.02)}, {"temperature", 20}}};
+  doc["ambient"] = {{"temperature", 20}, {"heat_transfer_coefficient", 10}};
+  return doc;
+}
+
+TEST_F(HeatTest, AnIsothermalSceneBuildsNoHeatStageAndKeepsItsEnthalpy) {
+  const Scene scene = scene_from_json(isothermal_flow_scene());
+  Solver s(cl(), scene, initial_state(scene));
+  EXPECT_FALSE(has_stage(s, "heat"));
+  EXPECT_NE(s.heat_reason().find("no heat"), std::string::npos) << s.heat_reason();
+  const HostParticles before = s.particles();
+  for (int k = 0; k < 20; ++k) s.step();
+  // The particles were sorted and moved; each keeps the enthalpy it started with, by id.
+  const HostParticles after = s.particles();
+  std::vector<Float2> start(before.size());
+  for (std::size_t i = 0; i < before.size(); ++i) start[before.id[i]] = before.enthalpy[i];
+  for (std::size_t i = 0; i < after.size(); ++i) ASSERT_EQ(after.enthalpy[i], start[after.id[i]]) << i;
+  for (float T : s.temperatures()) ASSERT_NEAR(T, 20.0f, 1e-4f);
+  // Summed in another order after the sort: equal to double rounding.
+  EXPECT_NEAR(s.total_enthalpy(), s.energy_budget().initial, 1e-12 * std::abs(s.energy_budget().initial));
+  EXPECT_LT(closure_relative(s), 1e-12);
+  // The state file carries the enthalpy and the budget as a heated run's does.
+  const SimState st = s.state();
+  EXPECT_EQ(st.particles.enthalpy, after.enthalpy);
+  EXPECT_EQ(EnergyBudget::from_vector(st.energy_budget).initial, s.energy_budget().initial);
+}
+
+TEST_F(HeatTest, HeatIsBuiltForWhatCanChangeATemperature) {
+  Json warm_air = isothermal_flow_scene();
+  warm_air["ambient"]["temperature"] = 25;
+  Json no_air = isothermal_flow_scene();  // the air exchanges nothing
+  no_air["ambient"]["heat_transfer_coefficient"] = 0;
+  Json warm_water = isothermal_flow_scene();
+  warm_water["fluids"][0]["temperature"] = 30;
+  Json heat_off = warm_water;
+  heat_off["heat"] = {{"enabled", false}};
+  Json dryer_off = isothermal_flow_scene();
+  dryer_off["dryers"] = {{{"position", {0.02, 0.02, 0.06}}, {"direction", {0, 0, -1}}, {"on", false}}};
+  Json lamp_off = isothermal_flow_scene();
+  lamp_off["lamps"] = {{{"centre", {0.02, 0.02, 0.038}},
+                        {"normal", {0, 0, -1}},
+                        {"width", 0.02},
+                        {"height", 0.02},
+                        {"temperature", 500},
+                        {"on", false}}};
+  const std::vector<std::pair<Json, bool>> cases = {{warm_air, true},  {no_air, false},   {warm_water, true},
+                                                    {heat_off, false}, {dryer_off, true}, {lamp_off, true}};
+  for (const auto& [doc, heat] : cases) {
+    const Scene scene = scene_from_json(doc);
+    Solver s(cl(), scene, initial_state(scene));
+    EXPECT_EQ(has_stage(s, "heat"), heat) << doc.dump() << ": " << s.heat_reason();
+    s.step();
+  }
+  // Lamps that are all off build no photon grid until one is switched on.
+  const Scene scene = scene_from_json(lamp_off);
+  Solver s(cl(), scene, initial_state(scene));
+  const auto tracing = [&s] {
+    const std::vector<std::string> st = s.stages();
+    return std::find(st.begin(), st.end(), "photons") != st.end();
+  };
+  EXPECT_FALSE(tracing());
+  EXPECT_TRUE(has_stage(s, "photons (when a lamp is on)"));
+  s.step();
+  EXPECT_EQ(s.energy_budget().lamp_emitted, 0.0);
+  Lamp lamp = s.lamps().at(0);
+  lamp.on = true;
+  s.set_lamp(0, lamp);
+  EXPECT_TRUE(tracing());
+  for (int k = 0; k < 3; ++k) s.step();
+  EXPECT_GT(s.energy_budget().lamp_emitted, 0.0);
+  EXPECT_LT(closure_relative(s), 1e-6);
+}
+
 TEST(DryerModel, ConeSpeedDistanceAndAngle) {
-  dryer::DryerJet j{0, 0, 0, 0, 0, -1, static_cast<float>(20 * M_PI / 180), 0.5f, 60.0f, 10.0f, 0.04f,
+  dryer::DryerJet j{0,
+                    0,
+                    0,
+                    0,
+                    0,
+                    -1,
+                    static_cast<float>(20 * M_PI / 180),
+                    0.5f,
+                    60.0f,
+                    10.0f,
+                    0.04f,
                     dryer::dryer_coefficient(0.04f)};
   const auto on_axis = dryer::dryer_air(j, 0, 0, -0.1f, 20.0f);
   EXPECT_GT(on_axis.x, 0.0f);
@@ -279,8 +399,10 @@ TEST(ThermalLaw, EnthalpyAndTemperatureInvertAcrossTheMeltingPoint) {
   const Scene scene = scene_from_json(doc);
   const auto table = material_thermal_table(scene, 1000);
   const int water = 0, ice = 1;
-  for (double T : {-40.0, -1.0, 0.0}) EXPECT_NEAR(temperature_at(table[ice], enthalpy_at(scene, ice, T)), T, 1e-9);
-  for (double T : {0.0, 1.0, 90.0}) EXPECT_NEAR(temperature_at(table[water], enthalpy_at(scene, water, T)), T, 1e-9);
+  for (double T : {-40.0, -1.0, 0.0})
+    EXPECT_NEAR(temperature_at(table[ice], enthalpy_at(scene, ice, T)), T, 1e-9);
+  for (double T : {0.0, 1.0, 90.0})
+    EXPECT_NEAR(temperature_at(table[water], enthalpy_at(scene, water, T)), T, 1e-9);
   // The pair shares one reference: water at 0 °C holds exactly the latent heat more than ice at 0 °C.
   EXPECT_DOUBLE_EQ(enthalpy_at(scene, water, 0.0) - enthalpy_at(scene, ice, 0.0), 334000.0);
   EXPECT_DOUBLE_EQ(liquid_fraction_at(table[ice], 167000.0), 0.5);
@@ -333,8 +455,8 @@ TEST(HeatScene, ErrorsNameTheirPath) {
   doc["dryers"] = {{{"position", {0, 0, 0}}, {"direction", {0, 0, 0}}}};
   EXPECT_EQ(error_path(doc), "dryers[0].direction");
   doc = base;
-  doc["lamps"] = {{{"centre", {0, 0, 0}}, {"normal", {0, 0, 1}}, {"width", 0.1}, {"height", 0.1},
-                   {"temperature", -300}}};
+  doc["lamps"] = {
+      {{"centre", {0, 0, 0}}, {"normal", {0, 0, 1}}, {"width", 0.1}, {"height", 0.1}, {"temperature", -300}}};
   EXPECT_EQ(error_path(doc), "lamps[0].temperature");
   doc = base;
   doc["heat"] = {{"time_scale", 0}};

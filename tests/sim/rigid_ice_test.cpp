@@ -306,8 +306,10 @@ TEST_F(RigidIceTest, ResumingFromAStateFileIsBitwiseIdentical) {
   const SimState sa = a.state(), sb = b.state();
   EXPECT_EQ(sa.particles.position, sb.particles.position);
   EXPECT_EQ(sa.particles.velocity, sb.particles.velocity);
-  EXPECT_EQ(sa.rigid_body, sb.rigid_body);
-  EXPECT_EQ(sa.rigid_offset, sb.rigid_offset);
+  ASSERT_TRUE(sa.particles.column("body") && sb.particles.column("body"));
+  ASSERT_TRUE(sa.particles.column("body_offset") && sb.particles.column("body_offset"));
+  EXPECT_EQ(sa.particles.column("body")->bytes, sb.particles.column("body")->bytes);
+  EXPECT_EQ(sa.particles.column("body_offset")->bytes, sb.particles.column("body_offset")->bytes);
   EXPECT_EQ(sa.rigid_bodies, sb.rigid_bodies);
   EXPECT_EQ(sa.rigid_labelling, sb.rigid_labelling);
   EXPECT_FALSE(sa.rigid_bodies.empty());
