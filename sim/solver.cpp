@@ -38,14 +38,6 @@ std::vector<std::string> with_prelude(std::initializer_list<std::string> files) 
 
 cl::NDRange global_for(std::size_t n) { return cl::NDRange(std::max<std::size_t>(n, 1)); }
 
-ClGrid cl_grid(const Solver::GridInfo& gi) {
-  return {{{gi.origin.x(), gi.origin.y(), gi.origin.z(), 0.f}},
-          {{1.0f / gi.cells.x(), 1.0f / gi.cells.y(), 1.0f / gi.cells.z(), 0.f}},
-          gi.nx,
-          gi.ny,
-          gi.nz};
-}
-
 std::vector<float> rigid_mass_scales(const Scene& scene, double rest_density) {
   std::vector<float> out;
   for (const Material& m : scene.materials) out.push_back(static_cast<float>(mass_scale(m, rest_density)));
@@ -185,50 +177,7 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     lo = lo.cwiseMin(Eigen::Vector3f(x[0], x[1], x[2]));
     hi = hi.cwiseMax(Eigen::Vector3f(x[0], x[1], x[2]));
   }
-  // A few ulps above H / reach, so float rounding in grid_cell() never puts a neighbour just inside
-  // the support more than `reach` cells away.
-  grid_.cell = k_.support / float(kGridReach) * (1.0f + 8.0f * std::numeric_limits<float>::epsilon());
-  grid_.reach = kGridReach;
-  grid_.origin = lo - Eigen::Vector3f::Constant(grid_.cell);
-  const Eigen::Vector3f ext = hi + Eigen::Vector3f::Constant(grid_.cell) - grid_.origin;
-  // Counted in double and checked before any conversion to int: particles far out (or a tiny spacing)
-  // would overflow an int cell count into a negative one that passed the check below.
-  const Eigen::Vector3d count = (ext.cast<double>() / double(grid_.cell)).array().ceil() + 1.0;
-  if (!count.allFinite() || count.prod() > double(1u << 28)) {
-    std::ostringstream needed;
-    needed.precision(3);
-    needed << count.prod();
-    throw SceneError("spacing", "the neighbour grid would need " + needed.str() + " cells (at most " +
-                                    std::to_string(1u << 28) + "); use a smaller domain or a larger spacing");
-  }
-  grid_.nx = static_cast<int>(count.x());
-  grid_.ny = static_cast<int>(count.y());
-  grid_.nz = static_cast<int>(count.z());
-  grid_.cells = Eigen::Vector3f::Constant(grid_.cell);
-  // A periodic axis is cut into whole cells of at least H between the domain's faces, so the cells
-  // around one wrap exactly (the scene guarantees at least three).
-  int* counts[3] = {&grid_.nx, &grid_.ny, &grid_.nz};
-  for (int a = 0; a < 3; ++a) {
-    if (!scene.solver.periodic[static_cast<std::size_t>(a)]) continue;
-    const float length = static_cast<float>(scene.domain.max[a] - scene.domain.min[a]);
-    *counts[a] = std::max(3, static_cast<int>(std::floor(length / grid_.cell)));
-    grid_.cells[a] = length / float(*counts[a]);
-    grid_.origin[a] = static_cast<float>(scene.domain.min[a]);
-  }
-  const double cells = double(grid_.nx) * grid_.ny * grid_.nz;
-  ncells_ = static_cast<std::uint32_t>(cells);
-  int bits = 1;
-  while (bits < 32 && (ncells_ - 1) >> bits) ++bits;
-  // The fewest radix passes of at most 11 bits, the key's bits spread evenly over them (17 bits: two
-  // passes of 9 rather than three of 8).
-  sort_passes_ = static_cast<std::uint32_t>((bits + 10) / 11);
-  radix_bits_ = static_cast<std::uint32_t>((bits + int(sort_passes_) - 1) / int(sort_passes_));
-  // About 32 tiles (whole multiples of 256 particles): enough work-items to keep the cores busy, few
-  // enough that each tile's per-digit bookkeeping is small beside its particles.
-  tile_ = static_cast<std::uint32_t>(std::max<std::size_t>(256, (n_ / 32 + 255) / 256 * 256));
-  ntiles_ = static_cast<std::uint32_t>((n_ + tile_ - 1) / tile_);
-  // Lane loads (SIMD lanes, sim/kernels/grid_common.h) read up to 15 floats past the last particle.
-  stride_ = static_cast<std::uint32_t>((n_ + 16 + 15) / 16 * 16);
+  layout_ = layout_for(n_);
 
   // Only the kernel and EOS this scene uses are compiled in.
   std::ostringstream opts;
@@ -243,35 +192,11 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   // start (measured: docs/BENCHMARKS.md). Nothing physical lives below 1e-38.
   opts << " -cl-denorms-are-zero";
   opts << " -DTHAW_REACH=" << kGridReach << " -DTHAW_VW=" << kLanes;
-  const HeatPlan plan = plan_heat(scene, p);
-  heat_ = plan.build;
-  heat_reason_ = plan.reason;
-  const auto grid =
-      cl.build(with_prelude({"grid.cl"}), opts.str() + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_));
+  grid_ = std::make_unique<NeighbourGrid>(cl, scene_, k_.support, kGridReach, opts.str(), layout_, lo, hi);
   const auto boundary = cl.build(with_prelude({"boundary.cl"}), opts.str());
   const auto density = cl.build(with_prelude({"density.cl"}), opts.str());
   const auto forces = cl.build(with_prelude({"forces.cl"}), opts.str());
   const auto integrate = cl.build(with_prelude({"integrate.cl", "step_limits.cl"}), opts.str());
-  if (heat_) {
-    std::string heat_opts = opts.str() + " -DTHAW_EXPOSED_AREA=" + scene.heat.exposed_area;
-    if (plan.ambient) heat_opts += " -DTHAW_AMBIENT";
-    if (plan.dryers) heat_opts += " -DTHAW_DRYERS";
-    if (plan.walls) heat_opts += " -DTHAW_WALL_HEAT";
-    if (plan.lamps) heat_opts += " -DTHAW_LAMPS";
-    for (int a = 0; a < 3; ++a)
-      if (scene.solver.periodic[static_cast<std::size_t>(a)])
-        heat_opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
-    const auto heat = cl.build(with_prelude({"thermal_law.h", "dryer_model.h", "heat.cl"}), heat_opts);
-    k_thermal_state_ = cl::Kernel(heat, "thermal_state");
-    k_heat_ = cl::Kernel(heat, "heat");
-    k_absorb_ = cl::Kernel(heat, "absorb_photons");
-    k_heat_budget_ = cl::Kernel(heat, "heat_budget");
-  }
-  k_cell_keys_ = cl::Kernel(grid, "cell_keys");
-  k_hist_ = cl::Kernel(grid, "radix_histogram");
-  k_scan_ = cl::Kernel(grid, "radix_scan_rows");
-  k_scatter_ = cl::Kernel(grid, "radix_scatter");
-  k_starts_ = cl::Kernel(grid, "cell_starts");
   k_psi_ = cl::Kernel(boundary, "boundary_psi");
   k_set_mass_ = cl::Kernel(boundary, "set_mass");
   k_density_ = cl::Kernel(density, "density");
@@ -294,52 +219,20 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     if (f.name == "material") f_.material = h;
     if (f.name == "id") f_.id = h;
   }
-  if (heat_) f_.enthalpy = store_.add({"enthalpy", FieldType::Float32, 2});
+  const HeatPlan plan = plan_heat(scene, p);
+  heat_reason_ = plan.reason;
+  if (plan.build)
+    heat_ = std::make_unique<HeatStage>(cl, store_, f_, scene_, plan, k_, opts.str(), layout_, lo, hi);
   state_ = buf(n * 16);
   accel_ = buf(n * 16);
-  for (int i = 0; i < 2; ++i) {
-    keys_[i] = buf(n * 4);
-    order_[i] = buf(n * 4);
-  }
-  hist_ = buf((std::size_t(1) << radix_bits_) * std::max<std::uint32_t>(ntiles_, 1) * 4);
-  totals_ = buf((std::size_t(1) << radix_bits_) * 4);
   scratch_ = buf(n * 4);
-  soa_ = buf(std::size_t(stride_) * 7 * 4);
-  derived_ = buf(std::size_t(stride_) * 3 * 4);
+  derived_ = buf(std::size_t(layout_.stride) * 3 * 4);
   // The padding past the last particle is read by masked lanes only; keep it finite anyway.
-  cl.queue().enqueueFillBuffer(soa_, 0.0f, 0, std::size_t(stride_) * 7 * 4);
-  cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(stride_) * 3 * 4);
+  cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(layout_.stride) * 3 * 4);
   table_ = material_thermal_table(scene, k_.rest_density);
-  if (heat_) {
-    materials_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                            table_.size() * sizeof(MaterialThermal), table_.data());
-    thermal_ = buf(std::size_t(stride_) * 3 * 4);
-    cl.queue().enqueueFillBuffer(thermal_, 0.0f, 0, std::size_t(stride_) * 3 * 4);
-    if (plan.lamps) {
-      lamp_energy_ = buf(n * 4);
-      cl.queue().enqueueFillBuffer(lamp_energy_, 0.0f, 0, n * 4);
-    }
-    budget_parts_ = buf(std::size_t(stride_) * 5 * 4);
-    budget_tiles_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 5 * 4);
-    budget_bad_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 4);
-    phase_changed_ = buf(4);
-    cl.queue().enqueueFillBuffer(phase_changed_, cl_uint(0), 0, 4);
-    dryers_ = buf(std::max<std::size_t>(scene.dryers.size(), 1) * sizeof(dryer::DryerJet));
-    // Voxels of one spacing over every particle: a lattice of that spacing puts one particle in each,
-    // at the centre for the lattice through the lowest particle (not on a face, where rounding could
-    // put two in one voxel and leave a hole next to it). Built once a lamp is on (start_photons).
-    photon_grid_.cell = static_cast<float>(scene.spacing);
-    photon_grid_.origin = lo - Eigen::Vector3f::Constant(1.5f * photon_grid_.cell);
-    const Eigen::Vector3f span = hi + Eigen::Vector3f::Constant(photon_grid_.cell) - photon_grid_.origin;
-    photon_grid_.nx = static_cast<int>(std::ceil(span.x() / photon_grid_.cell)) + 1;
-    photon_grid_.ny = static_cast<int>(std::ceil(span.y() / photon_grid_.cell)) + 1;
-    photon_grid_.nz = static_cast<int>(std::ceil(span.z() / photon_grid_.cell)) + 1;
-    start_photons();
-  }
-  cell_start_ = buf((std::size_t(ncells_) + 1) * 4);
   clamped_ = buf(4);
-  limits_f_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 8);
-  limits_i_ = buf(std::size_t(std::max<std::uint32_t>(ntiles_, 1)) * 8);
+  limits_f_ = buf(std::size_t(std::max<std::uint32_t>(layout_.ntiles, 1)) * 8);
+  limits_i_ = buf(std::size_t(std::max<std::uint32_t>(layout_.ntiles, 1)) * 8);
 
   // Boundary particles sampled by sample_scene() carry no mass yet: their Psi = rho0 V_b comes from
   // the solver's rest density. Walls here sit on the fluid lattice and fill the kernel support, so the
@@ -384,9 +277,9 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
 Solver::~Solver() = default;
 
 ParticleBuffers Solver::buffers() const {
-  return {store_[f_.position], store_[f_.velocity], state_,
-          store_[f_.phase],    store_[f_.material], store_[f_.id],
-          cell_start_,         cl_grid(grid_),      static_cast<std::uint32_t>(n_)};
+  return {store_[f_.position], store_[f_.velocity],    state_,
+          store_[f_.phase],    store_[f_.material],    store_[f_.id],
+          grid_->cell_start(), cl_grid(grid_->info()), static_cast<std::uint32_t>(n_)};
 }
 
 void Solver::upload(const HostParticles& p) {
@@ -414,36 +307,7 @@ void Solver::timed(Stage s, F&& f) {
 }
 
 void Solver::build_grid() {
-  if (n_ == 0) return;
-  auto& q = cl_.queue();
-  const auto n = static_cast<cl_uint>(n_);
-  const ClGrid g = cl_grid(grid_);
-  const auto& d = scene_.domain;
-  const cl_float4 dmin{{float(d.min.x()), float(d.min.y()), float(d.min.z()), 0.f}};
-  const cl_float4 dmax{{float(d.max.x()), float(d.max.y()), float(d.max.z()), 0.f}};
-  set_args(k_cell_keys_, store_[f_.position], store_[f_.velocity], store_[f_.phase], keys_[0], order_[0],
-           clamped_, g, dmin, dmax, n);
-  launch(q, k_cell_keys_, n_);
-
-  for (std::uint32_t pass = 0; pass < sort_passes_; ++pass) {
-    const int src = pass % 2, dst = 1 - src;
-    const cl_uint shift = radix_bits_ * pass;
-    set_args(k_hist_, keys_[src], hist_, shift, n, tile_, ntiles_);
-    q.enqueueNDRangeKernel(k_hist_, cl::NullRange, global_for(ntiles_));
-    set_args(k_scan_, hist_, totals_, ntiles_);
-    q.enqueueNDRangeKernel(k_scan_, cl::NullRange, cl::NDRange(std::size_t(1) << radix_bits_));
-    set_args(k_scatter_, keys_[src], order_[src], keys_[dst], order_[dst], hist_, totals_, shift, n, tile_,
-             ntiles_);
-    q.enqueueNDRangeKernel(k_scatter_, cl::NullRange, global_for(ntiles_));
-  }
-  const cl::Buffer& keys = keys_[sort_passes_ % 2];
-  const cl::Buffer& order = order_[sort_passes_ % 2];
-
-  // Every declared field follows the sort in one pass (sim/particle_store.h).
-  store_.reorder(order, soa_, stride_);
-
-  set_args(k_starts_, keys, cell_start_, n, ncells_);
-  launch(q, k_starts_, n_ + 1);
+  grid_->build(store_, f_, clamped_);
   grid_built_ = true;
 }
 
@@ -451,8 +315,8 @@ void Solver::compute_boundary_psi() {
   build_grid();
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(n_);
-  const ClGrid g = cl_grid(grid_);
-  set_args(k_psi_, store_[f_.position], store_[f_.phase], cell_start_, g, k_.support, k_.rest_density,
+  const ClGrid g = cl_grid(grid_->info());
+  set_args(k_psi_, store_[f_.position], store_[f_.phase], grid_->cell_start(), g, k_.support, k_.rest_density,
            scratch_, n);
   launch(q, k_psi_, n_);
   set_args(k_set_mass_, store_[f_.position], scratch_, n);
@@ -462,35 +326,29 @@ void Solver::compute_boundary_psi() {
 
 void Solver::compute_density() {
   if (n_ == 0) return;
-  const ClGrid g = cl_grid(grid_);
+  const ClGrid g = cl_grid(grid_->info());
   const auto& s = scene_.solver;
-  set_args(k_density_, store_[f_.position], soa_, stride_, store_[f_.phase], cell_start_, g, k_.support,
-           k_.rest_density, k_.stiffness, static_cast<float>(s.gamma), k_.visc_fluid, k_.visc_boundary,
-           store_[f_.density], state_, derived_, static_cast<cl_uint>(n_));
+  set_args(k_density_, store_[f_.position], grid_->soa(), layout_.stride, store_[f_.phase],
+           grid_->cell_start(), g, k_.support, k_.rest_density, k_.stiffness, static_cast<float>(s.gamma),
+           k_.visc_fluid, k_.visc_boundary, store_[f_.density], state_, derived_, static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_density_, n_);
 }
 
 void Solver::compute_forces() {
   if (n_ == 0) return;
-  const ClGrid g = cl_grid(grid_);
+  const ClGrid g = cl_grid(grid_->info());
   const float h = k_.smoothing;
   const cl_float4 gravity{
       {float(scene_.gravity.x()), float(scene_.gravity.y()), float(scene_.gravity.z()), 0.f}};
-  set_args(k_forces_, store_[f_.position], store_[f_.velocity], soa_, derived_, stride_, state_,
-           store_[f_.phase], cell_start_, g, k_.support, gravity, 0.01f * h * h, k_.rest_density,
-           k_.repulsion, k_.repulsion_range, k_.repulsion_damping, accel_, static_cast<cl_uint>(n_));
+  set_args(k_forces_, store_[f_.position], store_[f_.velocity], grid_->soa(), derived_, layout_.stride,
+           state_, store_[f_.phase], grid_->cell_start(), g, k_.support, gravity, 0.01f * h * h,
+           k_.rest_density, k_.repulsion, k_.repulsion_range, k_.repulsion_damping, accel_,
+           static_cast<cl_uint>(n_));
   launch(cl_.queue(), k_forces_, n_);
 }
 
 double Solver::heat_time_step() const {
-  if (!heat_) return std::numeric_limits<double>::infinity();
-  double dt = std::min(k_.diffusion_dt, k_.wall_dt);
-  double h_air = scene_.heat.ambient_coefficient;
-  for (const Dryer& d : scene_.dryers)
-    if (d.on && d.speed > 0)
-      h_air += dryer::dryer_coefficient(static_cast<float>(d.nozzle_diameter)) * std::sqrt(d.speed);
-  if (h_air > 0) dt = std::min(dt, 0.5 * k_.exposed_capacity / (scene_.heat.time_scale * h_air));
-  return dt;
+  return heat_ ? heat_->max_dt() : std::numeric_limits<double>::infinity();
 }
 
 double Solver::choose_time_step() {
@@ -510,13 +368,13 @@ double Solver::choose_time_step() {
   std::uint32_t fastest = 0, bad = 0xffffffffu;
   if (n_ > 0) {
     set_args(k_limits_, store_[f_.position], store_[f_.velocity], accel_, store_[f_.phase], limits_f_,
-             limits_i_, static_cast<cl_uint>(n_), tile_);
-    cl_.queue().enqueueNDRangeKernel(k_limits_, cl::NullRange, global_for(ntiles_));
-    std::vector<cl_float2> f(ntiles_);
-    std::vector<cl_uint2> ix(ntiles_);
-    cl_.queue().enqueueReadBuffer(limits_f_, CL_FALSE, 0, ntiles_ * 8, f.data());
-    cl_.queue().enqueueReadBuffer(limits_i_, CL_TRUE, 0, ntiles_ * 8, ix.data());
-    for (std::uint32_t t = 0; t < ntiles_; ++t) {
+             limits_i_, static_cast<cl_uint>(n_), layout_.tile);
+    cl_.queue().enqueueNDRangeKernel(k_limits_, cl::NullRange, global_for(layout_.ntiles));
+    std::vector<cl_float2> f(layout_.ntiles);
+    std::vector<cl_uint2> ix(layout_.ntiles);
+    cl_.queue().enqueueReadBuffer(limits_f_, CL_FALSE, 0, layout_.ntiles * 8, f.data());
+    cl_.queue().enqueueReadBuffer(limits_i_, CL_TRUE, 0, layout_.ntiles * 8, ix.data());
+    for (std::uint32_t t = 0; t < layout_.ntiles; ++t) {
       if (f[t].s[0] > vmax2) {
         vmax2 = f[t].s[0];
         fastest = ix[t].s[0];
@@ -581,115 +439,14 @@ double Solver::choose_time_step() {
 }
 
 void Solver::trace_photons(double dt) {
-  if (!photons_ || n_ == 0) return;
-  photons_->build_occupancy(store_[f_.position], store_[f_.phase], static_cast<std::uint32_t>(n_));
-  for (std::size_t l = 0; l < scene_.lamps.size(); ++l) {
-    const Lamp& lamp = scene_.lamps[l];
-    if (!lamp.on) continue;
-    // The rectangle's width runs horizontally (across the normal and z) where it can.
-    const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
-    Eigen::Vector3d u = lamp.normal.cross(z);
-    u = u.norm() > 1e-6 ? u.normalized() : Eigen::Vector3d::UnitX();
-    const Eigen::Vector3d v = lamp.normal.cross(u);
-    LampGeometry geo;
-    geo.centre = lamp.centre.cast<float>();
-    geo.normal = lamp.normal.cast<float>();
-    geo.half_u = (0.5 * lamp.width * u).cast<float>();
-    geo.half_v = (0.5 * lamp.height * v).cast<float>();
-    const auto photons = static_cast<std::uint32_t>(lamp.photons);
-    const double energy = photon_energy(lamp.emissivity, lamp.temperature, lamp.width * lamp.height,
-                                        scene_.heat.time_scale * dt, photons);
-    const PhotonTally tally = photons_->trace(geo, photons, steps_, static_cast<std::uint32_t>(l), hits_);
-    const float e = static_cast<float>(energy);
-    set_args(k_absorb_, hits_, lamp_energy_, e, static_cast<cl_uint>(n_));
-    launch(cl_.queue(), k_absorb_, n_);
-    budget_.lamp_emitted += double(e) * double(tally.emitted);
-    budget_.lamp_escaped += double(e) * double(tally.escaped());
-  }
+  if (heat_) heat_->trace_photons(dt, steps_, budget_);
 }
 
-void Solver::upload_dryers() {
-  std::vector<dryer::DryerJet> jets;
-  for (const Dryer& d : scene_.dryers) {
-    dryer::DryerJet j{};
-    j.px = float(d.position.x());
-    j.py = float(d.position.y());
-    j.pz = float(d.position.z());
-    j.dx = float(d.direction.x());
-    j.dy = float(d.direction.y());
-    j.dz = float(d.direction.z());
-    j.half_angle = float(d.half_angle * M_PI / 180.0);
-    j.reach = float(d.reach);
-    j.temperature = float(d.temperature);
-    j.speed = d.on ? float(d.speed) : 0.0f;
-    j.diameter = float(d.nozzle_diameter);
-    j.coefficient = dryer::dryer_coefficient(j.diameter);
-    jets.push_back(j);
-  }
-  if (!jets.empty())
-    cl_.queue().enqueueWriteBuffer(dryers_, CL_TRUE, 0, jets.size() * sizeof(dryer::DryerJet), jets.data());
-  dryers_dirty_ = false;
-}
+NeighbourView Solver::neighbours() const { return grid_->view(); }
 
 void Solver::compute_heat(double dt) {
-  if (!heat_ || n_ == 0) return;
-  auto& q = cl_.queue();
-  const auto n = static_cast<cl_uint>(n_);
-  set_args(k_thermal_state_, store_[f_.position], store_[f_.density], store_[f_.enthalpy], store_[f_.phase],
-           store_[f_.material], materials_, k_.rest_density, static_cast<cl_int>(scene_.solver.flow ? 1 : 0),
-           thermal_, stride_, n);
-  launch(q, k_thermal_state_, n_);
-  if (dryers_dirty_) upload_dryers();
-  const ClGrid g = cl_grid(grid_);
-  cl_float4 period{{0.f, 0.f, 0.f, 0.f}};
-  for (int a = 0; a < 3; ++a)
-    if (scene_.solver.periodic[static_cast<std::size_t>(a)])
-      period.s[a] = static_cast<float>(scene_.domain.max[a] - scene_.domain.min[a]);
-  const float dx = static_cast<float>(scene_.spacing);
-  const float h = k_.smoothing;
-  // Iwasaki's voxel faces: a neighbour within 1.2 spacings covers one (lattice face neighbours sit at
-  // 1, edge neighbours at 1.41 spacings).
-  const float exposed_r2 = 1.44f * dx * dx;
-  set_args(k_heat_, store_[f_.position], store_[f_.velocity], store_[f_.enthalpy], store_[f_.phase],
-           store_[f_.material], materials_, soa_, thermal_, stride_, cell_start_, g, k_.support,
-           0.01f * h * h, period, exposed_r2, dx * dx, static_cast<float>(scene_.heat.ambient_temperature),
-           static_cast<float>(scene_.heat.ambient_coefficient), dryers_,
-           static_cast<cl_uint>(scene_.dryers.size()), lamp_energy_() ? lamp_energy_ : dryers_,
-           static_cast<float>(scene_.heat.time_scale * dt), budget_parts_, phase_changed_, n);
-  launch(q, k_heat_, n_);
-  set_args(k_heat_budget_, budget_parts_, store_[f_.enthalpy], stride_, budget_tiles_, budget_bad_, n, tile_);
-  q.enqueueNDRangeKernel(k_heat_budget_, cl::NullRange, global_for(ntiles_));
-  std::vector<float> sums(std::size_t(ntiles_) * 5);
-  std::vector<cl_uint> bad(ntiles_);
-  cl_uint changed = 0;
-  q.enqueueReadBuffer(budget_tiles_, CL_FALSE, 0, sums.size() * 4, sums.data());
-  // Rigid ice relabels after a phase change; the flag comes back with the budget (one wait, not two).
-  if (rigid_) q.enqueueReadBuffer(phase_changed_, CL_FALSE, 0, 4, &changed);
-  q.enqueueReadBuffer(budget_bad_, CL_TRUE, 0, bad.size() * 4, bad.data());
-  for (std::uint32_t t = 0; t < ntiles_; ++t) {
-    if (bad[t] != 0xffffffffu) {
-      Float4 x;
-      std::uint32_t id = 0;
-      q.enqueueReadBuffer(store_[f_.position], CL_TRUE, bad[t] * 16, 16, x.data());
-      q.enqueueReadBuffer(store_[f_.id], CL_TRUE, bad[t] * 4, 4, &id);
-      std::ostringstream os;
-      os << "step " << steps_ + 1 << " (t = " << time_ << " s): particle " << id << " at (" << x[0] << ", "
-         << x[1] << ", " << x[2]
-         << ") m has a non-finite enthalpy; lower solver.max_dt or heat.time_scale, or tame the "
-         << "heat sources";
-      throw BlowUpError(os.str());
-    }
-    const float* t5 = &sums[std::size_t(t) * 5];
-    budget_.ambient += t5[0];
-    budget_.lamps += t5[1];
-    budget_.dryers += t5[2];
-    budget_.walls += t5[3];
-    budget_.held += t5[4];
-  }
-  if (changed) {
-    rigid_->note_phase_change();
-    q.enqueueFillBuffer(phase_changed_, cl_uint(0), 0, 4);
-  }
+  if (!heat_) return;
+  if (heat_->run(dt, neighbours(), budget_, steps_, time_, rigid_ != nullptr)) rigid_->note_phase_change();
 }
 
 void Solver::label_ice() {
@@ -748,11 +505,8 @@ void Solver::warm_up() {
   if (rigid_) rigid_->compute_forces(buffers());
   choose_time_step();
   integrate(0.0);
-  if (heat_) {
-    // dt = 0 adds no heat; the budget's sums of zero leave it unchanged.
-    if (photons_) photons_->warm_up();
-    compute_heat(0.0);
-  }
+  // dt = 0 adds no heat; the budget's sums of zero leave it unchanged.
+  if (heat_) heat_->warm_up(neighbours(), budget_);
   cl_.queue().finish();
 }
 
@@ -773,7 +527,7 @@ void Solver::set_dryer(std::size_t index, const Dryer& d) {
   Dryer checked = d;
   checked.direction = unit_direction(d.direction, path + ".direction");
   scene_.dryers[index] = checked;
-  dryers_dirty_ = true;
+  if (heat_) heat_->dryers_changed();
 }
 
 void Solver::set_lamp(std::size_t index, const Lamp& l) {
@@ -793,16 +547,7 @@ void Solver::set_lamp(std::size_t index, const Lamp& l) {
   Lamp checked = l;
   checked.normal = unit_direction(l.normal, path + ".normal");
   scene_.lamps[index] = checked;
-  start_photons();
-}
-
-void Solver::start_photons() {
-  if (photons_ || !heat_) return;
-  if (std::none_of(scene_.lamps.begin(), scene_.lamps.end(), [](const Lamp& l) { return l.on; })) return;
-  const std::size_t n = std::max<std::size_t>(n_, 1);
-  hits_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, n * 4);
-  cl_.queue().enqueueFillBuffer(hits_, cl_uint(0), 0, n * 4);
-  photons_ = std::make_unique<PhotonTracer>(cl_, photon_grid_);
+  if (heat_) heat_->lamps_changed();
 }
 
 std::vector<std::string> Solver::stages() const {
@@ -812,7 +557,9 @@ std::vector<std::string> Solver::stages() const {
   if (rigid_) out.push_back("rigid ice");
   out.push_back("time step");
   if (heat_) {
-    out.push_back(photons_ ? "photons" : !scene_.lamps.empty() ? "photons (when a lamp is on)" : "");
+    out.push_back(heat_->tracing_photons() ? "photons"
+                  : !scene_.lamps.empty()  ? "photons (when a lamp is on)"
+                                           : "");
     out.push_back("heat (" + heat_reason_ + ")");
   }
   if (flow) out.push_back("integrate");
@@ -822,12 +569,7 @@ std::vector<std::string> Solver::stages() const {
 
 Solver::ThermalInputs Solver::thermal_inputs() const {
   ThermalInputs t;
-  if (!heat_ || n_ == 0) return t;
-  std::vector<float> all(std::size_t(stride_) * 3);
-  cl_.queue().enqueueReadBuffer(thermal_, CL_TRUE, 0, all.size() * 4, all.data());
-  t.temperature.assign(all.begin(), all.begin() + long(n_));
-  t.conductivity.assign(all.begin() + long(stride_), all.begin() + long(stride_ + n_));
-  t.volume.assign(all.begin() + 2 * long(stride_), all.begin() + long(2 * stride_ + n_));
+  if (heat_) heat_->thermal_inputs(t.temperature, t.conductivity, t.volume);
   return t;
 }
 
@@ -879,11 +621,7 @@ SimState Solver::state() const {
   return s;
 }
 
-std::vector<std::uint32_t> Solver::cell_starts() const {
-  std::vector<std::uint32_t> out(std::size_t(ncells_) + 1);
-  cl_.queue().enqueueReadBuffer(cell_start_, CL_TRUE, 0, out.size() * 4, out.data());
-  return out;
-}
+std::vector<std::uint32_t> Solver::cell_starts() const { return grid_->cell_starts(); }
 
 std::vector<float> Solver::densities() const {
   std::vector<float> out(n_);

@@ -10,10 +10,11 @@
 #include <vector>
 
 #include "sim/cl_runtime.h"
+#include "sim/heat_stage.h"
 #include "sim/kernels/thermal_law.h"
+#include "sim/neighbour_grid.h"
 #include "sim/particle_store.h"
 #include "sim/particles.h"
-#include "sim/photons.h"
 #include "sim/scene.h"
 #include "sim/stage_timers.h"
 #include "sim/state_file.h"
@@ -131,14 +132,8 @@ class Solver {
   const RigidIce* rigid_ice() const { return rigid_.get(); }
 
   // Cell geometry of the neighbour grid (for reference loops and tests).
-  struct GridInfo {
-    Eigen::Vector3f origin;
-    float cell = 0;
-    int nx = 0, ny = 0, nz = 0;
-    Eigen::Vector3f cells = Eigen::Vector3f::Zero();  // cell size per axis: `cell`, or a periodic axis's
-    int reach = 1;                                    // cells visited on each side
-  };
-  const GridInfo& grid() const { return grid_; }
+  using GridInfo = thaw::GridInfo;
+  const GridInfo& grid() const { return grid_->info(); }
   std::vector<std::uint32_t> cell_starts() const;
   std::vector<float> densities() const;
   std::vector<Float4> pressure_state() const;  // per particle (rho, p/rho^2, is_boundary, p)
@@ -154,8 +149,7 @@ class Solver {
   void compute_boundary_psi();
   ParticleBuffers buffers() const;
   void upload(const HostParticles& p);
-  void upload_dryers();
-  void start_photons();  // builds the photon tracer once heat is built and a lamp is on
+  NeighbourView neighbours() const;
   double heat_time_step() const;
   template <class F>
   void timed(Stage s, F&& f);
@@ -169,44 +163,28 @@ class Solver {
   std::uint64_t clamped_base_ = 0;
   double damping_ = 0;
   StageTimers timers_;
-  GridInfo grid_;
-  std::uint32_t ncells_ = 0;
-  std::uint32_t sort_passes_ = 0, radix_bits_ = 8;
-  std::uint32_t tile_ = 256, ntiles_ = 0;  // particles per work-item in the sort and the time-step limits
-  std::uint32_t stride_ = 0;  // length of each structure-of-arrays block: n rounded up, plus padding
+  ParticleLayout layout_;
 
+  // The step's stages, in step order (see step()); null where the scene does not need one.
   // Per-particle state, one buffer per declared field, reordered with the sort (sim/particle_store.h).
   ParticleStore store_;
-  struct Fields {
-    ParticleStore::Field position = 0, velocity = 0, density = 0, phase = 0, material = 0, id = 0,
-                         enthalpy = 0;
-  } f_;
-  // Derived each step: pressure state, accelerations; the reorder's structure-of-arrays copy of
-  // position, mass and velocity, and the density pass's pair coefficients (read by the forces pass).
-  cl::Buffer state_, accel_, soa_, derived_;
-  // Scratch: sort keys/values (two of each), histogram, one float per particle, cell starts, limits.
-  cl::Buffer keys_[2], order_[2], hist_, totals_, scratch_, cell_start_;
-  cl::Buffer clamped_, limits_f_, limits_i_;
-
-  cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_;
+  CoreFields f_;
+  std::unique_ptr<NeighbourGrid> grid_;
+  bool grid_built_ = false;
+  // The fluid passes (density, forces, time-step limits, integration): pressure state, accelerations,
+  // the density pass's pair coefficients (read by the forces pass), one float of scratch per particle,
+  // particles clamped into the domain, per-tile limits.
+  cl::Buffer state_, accel_, derived_, scratch_, clamped_, limits_f_, limits_i_;
   cl::Kernel k_psi_, k_set_mass_, k_density_, k_forces_, k_limits_, k_integrate_;
 
-  // Heat (built only when plan_heat says the scene needs it): enthalpy (hi, lo) per particle, reordered
-  // with the rest; the material table; T, k, V blocks for the neighbour loop; absorbed lamp energy;
-  // photon hits; the per-particle energies of the budget and their per-tile sums. Without heat the
-  // enthalpy never changes and stays on the host, by particle id (fixed_enthalpy_).
-  bool heat_ = false;
+  // Heat (sim/heat_stage.h), built only when plan_heat says the scene needs it. Without it the enthalpy
+  // never changes and stays on the host, by particle id (fixed_enthalpy_). The budget is the run's
+  // whatever is built; the thermal table gives the masses its enthalpy sum needs.
+  std::unique_ptr<HeatStage> heat_;
   std::string heat_reason_;
   std::vector<Float2> fixed_enthalpy_;
-  VoxelGridInfo photon_grid_;
-  bool grid_built_ = false;
   std::vector<thermal::MaterialThermal> table_;
   EnergyBudget budget_;
-  cl::Buffer materials_, thermal_, lamp_energy_, hits_, budget_parts_, budget_tiles_, budget_bad_, dryers_;
-  bool dryers_dirty_ = true;
-  std::unique_ptr<PhotonTracer> photons_;
-  cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_heat_budget_;
-  cl::Buffer phase_changed_;  // set by the heat pass when a particle changed phase
 
   // Rigid ice (built only when the scene has free ice and flow).
   std::unique_ptr<RigidIce> rigid_;

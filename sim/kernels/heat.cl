@@ -121,11 +121,14 @@ float exposed_area_iwasaki2010(int neighbours, float face_area) {
  * lamp_energy: each particle's absorbed photon energy this step [J], consumed (zeroed) here. */
 kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy, global uchar* phase,
                  global uchar* material, global const MaterialThermal* materials, global const float* soa,
-                 global const float* thermal, const uint stride, global const uint* cell_start, const Grid g,
-                 const float H, const float eta2, const float4 period, const float exposed_r2,
-                 const float face_area, const float ambient_temperature, const float ambient_coefficient,
-                 global const DryerJet* dryers, const uint ndryers, global float* lamp_energy,
-                 const float dt_heat, global float* budget, global uint* phase_changed, const uint n) {
+                 global const float* thermal, global const uint* cell_start, const Grid g, const HeatParams P,
+                 global const DryerJet* dryers, global float* lamp_energy, global float* budget,
+                 global uint* phase_changed) {
+  const float H = P.support, eta2 = P.eta2, exposed_r2 = P.exposed_r2, face_area = P.face_area;
+  const float ambient_temperature = P.ambient_temperature, ambient_coefficient = P.ambient_coefficient;
+  const float dt_heat = P.dt_heat;
+  const uint stride = P.stride, n = P.n, ndryers = P.ndryers;
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
   const uint i = get_global_id(0);
   if (i >= n) return;
   const float4 pi = pos[i];

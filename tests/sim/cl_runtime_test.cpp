@@ -1,9 +1,10 @@
 // Device choice and kernel builds: errors say what was looked for and where a kernel failed.
+#include "sim/cl_runtime.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 
-#include "sim/cl_runtime.h"
 #include "sim/error.h"
 #include "tests/test_support.h"
 
@@ -55,10 +56,12 @@ TEST_F(KernelBuild, MissingEmbeddedFileIsNamed) {
 }
 
 TEST_F(KernelBuild, EveryEmbeddedStageBuilds) {
-  for (const char* stage : {"grid.cl", "boundary.cl", "density.cl", "forces.cl", "integrate.cl", "step_limits.cl",
-                            "heat.cl"})
-    EXPECT_NO_THROW(cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h", "dryer_model.h", stage},
-                               "-DKERNEL_W=cubic_spline_w -DKERNEL_GRAD=cubic_spline_grad_factor -DTHAW_EOS_TAIT"))
+  for (const char* stage :
+       {"grid.cl", "boundary.cl", "density.cl", "forces.cl", "integrate.cl", "step_limits.cl", "heat.cl"})
+    EXPECT_NO_THROW(
+        cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h", "dryer_model.h",
+                    "heat_params.h", stage},
+                   "-DKERNEL_W=cubic_spline_w -DKERNEL_GRAD=cubic_spline_grad_factor -DTHAW_EOS_TAIT"))
         << stage;
 }
 

@@ -1,0 +1,30 @@
+/* The heat pass's scalar parameters as one struct, shared verbatim by the host (sim/heat_stage.cpp) and
+ * heat.cl; every member is 4 bytes, so both layouts agree (static_assert below). */
+#ifndef THAW_HEAT_PARAMS_H
+#define THAW_HEAT_PARAMS_H
+
+#ifndef __OPENCL_VERSION__
+namespace thaw::heat {
+#endif
+
+typedef struct {
+  float support;             /* kernel support H [m] */
+  float eta2;                /* 0.01 h^2, keeps the pair term finite at r -> 0 [m^2] */
+  float period_x, period_y, period_z; /* domain length along each periodic axis, 0 elsewhere [m] */
+  float exposed_r2;          /* squared radius within which a neighbour covers a face [m^2] */
+  float face_area;           /* dx^2 [m^2] */
+  float ambient_temperature; /* [°C] */
+  float ambient_coefficient; /* h [W/m^2/K] */
+  float dt_heat;             /* time_scale * dt [s] */
+  unsigned int ndryers;      /* entries of the dryer table */
+  unsigned int stride;       /* length of each structure-of-arrays block */
+  unsigned int n;            /* particles */
+  unsigned int pad0, pad1, pad2;
+} HeatParams;
+
+#ifndef __OPENCL_VERSION__
+static_assert(sizeof(HeatParams) == 64, "HeatParams must match its OpenCL layout");
+}  // namespace thaw::heat
+#endif
+
+#endif

@@ -1,0 +1,128 @@
+#include "sim/neighbour_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "sim/cl_launch.h"
+#include "sim/error.h"
+
+namespace thaw {
+
+ClGrid cl_grid(const GridInfo& gi) {
+  return {{{gi.origin.x(), gi.origin.y(), gi.origin.z(), 0.f}},
+          {{1.0f / gi.cells.x(), 1.0f / gi.cells.y(), 1.0f / gi.cells.z(), 0.f}},
+          gi.nx,
+          gi.ny,
+          gi.nz};
+}
+
+NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, int reach,
+                             const std::string& build_options, const ParticleLayout& layout,
+                             const Eigen::Vector3f& lo, const Eigen::Vector3f& hi)
+    : cl_(cl), scene_(scene), layout_(layout) {
+  // A few ulps above H / reach, so float rounding in grid_cell() never puts a neighbour just inside the
+  // support more than `reach` cells away.
+  info_.cell = support / float(reach) * (1.0f + 8.0f * std::numeric_limits<float>::epsilon());
+  info_.reach = reach;
+  info_.origin = lo - Eigen::Vector3f::Constant(info_.cell);
+  const Eigen::Vector3f ext = hi + Eigen::Vector3f::Constant(info_.cell) - info_.origin;
+  // Counted in double and checked before any conversion to int: particles far out (or a tiny spacing)
+  // would overflow an int cell count into a negative one that passed the check below.
+  const Eigen::Vector3d count = (ext.cast<double>() / double(info_.cell)).array().ceil() + 1.0;
+  if (!count.allFinite() || count.prod() > double(1u << 28)) {
+    std::ostringstream needed;
+    needed.precision(3);
+    needed << count.prod();
+    throw SceneError("spacing", "the neighbour grid would need " + needed.str() + " cells (at most " +
+                                    std::to_string(1u << 28) + "); use a smaller domain or a larger spacing");
+  }
+  info_.nx = static_cast<int>(count.x());
+  info_.ny = static_cast<int>(count.y());
+  info_.nz = static_cast<int>(count.z());
+  info_.cells = Eigen::Vector3f::Constant(info_.cell);
+  // A periodic axis is cut into whole cells of at least H between the domain's faces, so the cells around
+  // one wrap exactly (the scene guarantees at least three).
+  int* counts[3] = {&info_.nx, &info_.ny, &info_.nz};
+  for (int a = 0; a < 3; ++a) {
+    if (!scene.solver.periodic[static_cast<std::size_t>(a)]) continue;
+    const float length = static_cast<float>(scene.domain.max[a] - scene.domain.min[a]);
+    *counts[a] = std::max(3, static_cast<int>(std::floor(length / info_.cell)));
+    info_.cells[a] = length / float(*counts[a]);
+    info_.origin[a] = static_cast<float>(scene.domain.min[a]);
+  }
+  ncells_ = static_cast<std::uint32_t>(double(info_.nx) * info_.ny * info_.nz);
+  int bits = 1;
+  while (bits < 32 && (ncells_ - 1) >> bits) ++bits;
+  // The fewest radix passes of at most 11 bits, the key's bits spread evenly over them (17 bits: two
+  // passes of 9 rather than three of 8).
+  sort_passes_ = static_cast<std::uint32_t>((bits + 10) / 11);
+  radix_bits_ = static_cast<std::uint32_t>((bits + int(sort_passes_) - 1) / int(sort_passes_));
+
+  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "grid.cl"},
+                                build_options + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_));
+  k_cell_keys_ = cl::Kernel(program, "cell_keys");
+  k_hist_ = cl::Kernel(program, "radix_histogram");
+  k_scan_ = cl::Kernel(program, "radix_scan_rows");
+  k_scatter_ = cl::Kernel(program, "radix_scatter");
+  k_starts_ = cl::Kernel(program, "cell_starts");
+
+  auto& ctx = cl.context();
+  const std::size_t n = std::max<std::size_t>(layout.n, 1);
+  auto buf = [&](std::size_t bytes) {
+    return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
+  };
+  for (int i = 0; i < 2; ++i) {
+    keys_[i] = buf(n * 4);
+    order_[i] = buf(n * 4);
+  }
+  hist_ = buf((std::size_t(1) << radix_bits_) * std::max<cl_uint>(layout.ntiles, 1) * 4);
+  totals_ = buf((std::size_t(1) << radix_bits_) * 4);
+  cell_start_ = buf((std::size_t(ncells_) + 1) * 4);
+  soa_ = buf(std::size_t(layout.stride) * 7 * 4);
+  // The padding past the last particle is read by masked lanes only; keep it finite anyway.
+  cl.queue().enqueueFillBuffer(soa_, 0.0f, 0, std::size_t(layout.stride) * 7 * 4);
+}
+
+void NeighbourGrid::build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped) {
+  if (layout_.n == 0) return;
+  auto& q = cl_.queue();
+  const auto n = static_cast<cl_uint>(layout_.n);
+  const cl_uint tile = layout_.tile, ntiles = layout_.ntiles;
+  const ClGrid g = cl_grid(info_);
+  const auto& d = scene_.domain;
+  const cl_float4 dmin{{float(d.min.x()), float(d.min.y()), float(d.min.z()), 0.f}};
+  const cl_float4 dmax{{float(d.max.x()), float(d.max.y()), float(d.max.z()), 0.f}};
+  set_args(k_cell_keys_, store[f.position], store[f.velocity], store[f.phase], keys_[0], order_[0], clamped,
+           g, dmin, dmax, n);
+  launch(q, k_cell_keys_, layout_.n);
+
+  for (std::uint32_t pass = 0; pass < sort_passes_; ++pass) {
+    const int src = pass % 2, dst = 1 - src;
+    const cl_uint shift = radix_bits_ * pass;
+    set_args(k_hist_, keys_[src], hist_, shift, n, tile, ntiles);
+    q.enqueueNDRangeKernel(k_hist_, cl::NullRange, cl::NDRange(std::max<cl_uint>(ntiles, 1)));
+    set_args(k_scan_, hist_, totals_, ntiles);
+    q.enqueueNDRangeKernel(k_scan_, cl::NullRange, cl::NDRange(std::size_t(1) << radix_bits_));
+    set_args(k_scatter_, keys_[src], order_[src], keys_[dst], order_[dst], hist_, totals_, shift, n, tile,
+             ntiles);
+    q.enqueueNDRangeKernel(k_scatter_, cl::NullRange, cl::NDRange(std::max<cl_uint>(ntiles, 1)));
+  }
+  const cl::Buffer& keys = keys_[sort_passes_ % 2];
+  const cl::Buffer& order = order_[sort_passes_ % 2];
+
+  // Every declared field follows the sort in one pass (sim/particle_store.h).
+  store.reorder(order, soa_, layout_.stride);
+
+  set_args(k_starts_, keys, cell_start_, n, ncells_);
+  launch(q, k_starts_, layout_.n + 1);
+}
+
+std::vector<std::uint32_t> NeighbourGrid::cell_starts() const {
+  std::vector<std::uint32_t> out(std::size_t(ncells_) + 1);
+  cl_.queue().enqueueReadBuffer(cell_start_, CL_TRUE, 0, out.size() * 4, out.data());
+  return out;
+}
+
+}  // namespace thaw

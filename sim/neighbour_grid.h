@@ -1,0 +1,59 @@
+#pragma once
+// The neighbour grid stage: cell keys, a stable radix sort of the particles by cell, the reorder of every
+// declared field into that order (ParticleStore::reorder, which also writes the structure-of-arrays copy
+// the neighbour loops read) and each cell's range of sorted particles (sim/kernels/grid.cl). Every
+// stage that visits neighbours reads what this one leaves: view().
+#include <CL/opencl.hpp>
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/cl_grid.h"
+#include "sim/cl_runtime.h"
+#include "sim/particle_store.h"
+#include "sim/scene.h"
+#include "sim/stage.h"
+
+namespace thaw {
+
+// Cell geometry of the neighbour grid (for reference loops and tests).
+struct GridInfo {
+  Eigen::Vector3f origin;
+  float cell = 0;
+  int nx = 0, ny = 0, nz = 0;
+  Eigen::Vector3f cells = Eigen::Vector3f::Zero();  // cell size per axis: `cell`, or a periodic axis's
+  int reach = 1;                                    // cells visited on each side
+};
+ClGrid cl_grid(const GridInfo& g);
+
+class NeighbourGrid {
+ public:
+  // Cells of support / reach over the domain and every particle (min, max) plus one cell; whole cells
+  // along periodic axes. Throws SceneError ("spacing") when the grid would need more than 2^28 cells.
+  // `layout` gives the particle count and the tiles of the sort.
+  NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, int reach, const std::string& build_options,
+                const ParticleLayout& layout, const Eigen::Vector3f& particle_min,
+                const Eigen::Vector3f& particle_max);
+
+  // Sorts the particles by cell: keys (clamping particles that left the domain back into it and counting
+  // them in `clamped`), the radix sort, the reorder of every field of `store`, the cell ranges.
+  void build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped);
+
+  NeighbourView view() const { return {soa_, layout_.stride, cell_start_, cl_grid(info_)}; }
+  const GridInfo& info() const { return info_; }
+  const cl::Buffer& cell_start() const { return cell_start_; }
+  const cl::Buffer& soa() const { return soa_; }
+  std::vector<std::uint32_t> cell_starts() const;  // read back: ncells + 1 entries
+
+ private:
+  ClRuntime& cl_;
+  const Scene& scene_;
+  ParticleLayout layout_;
+  GridInfo info_;
+  std::uint32_t ncells_ = 0, sort_passes_ = 0, radix_bits_ = 8;
+  cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_;
+  cl::Buffer keys_[2], order_[2], hist_, totals_, cell_start_, soa_;
+};
+
+}  // namespace thaw

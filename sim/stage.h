@@ -1,0 +1,51 @@
+#pragma once
+// What the stages of a step share (sim/solver.h lists the step). A stage is a class built by the solver
+// only when the scene needs it; its constructor declares the particle fields it owns in the store
+// (sim/particle_store.h) and builds its kernels with only the options the scene uses; it offers its
+// limit on the time step (max_dt) and the state it keeps beyond its fields (save / restore) where it has
+// any, and its run methods take the views below. The stages today: NeighbourGrid
+// (sim/neighbour_grid.h), the fluid passes (Solver), RigidIce (sim/rigid_ice.h), HeatStage with its
+// photons (sim/heat_stage.h).
+#include <CL/opencl.hpp>
+#include <algorithm>
+#include <cstddef>
+
+#include "sim/cl_grid.h"
+#include "sim/particle_store.h"
+
+namespace thaw {
+
+// What the neighbour loops read, as the grid stage left it: the structure-of-arrays copy of position,
+// mass and velocity (blocks of `stride` floats), the cell ranges and the grid.
+struct NeighbourView {
+  const cl::Buffer& soa;
+  cl_uint stride = 0;
+  const cl::Buffer& cell_start;
+  ClGrid grid;
+};
+
+// How the particles' arrays are laid out: n particles, structure-of-arrays blocks of `stride` floats, and
+// the tiles of `tile` particles that per-tile reductions (time-step limits, budgets) use.
+struct ParticleLayout {
+  std::size_t n = 0;
+  cl_uint stride = 0, tile = 256, ntiles = 0;
+};
+
+// The layout for n particles: about 32 tiles (whole multiples of 256 particles), enough work-items to
+// keep the cores busy, few enough that each tile's per-digit bookkeeping in the sort is small beside its
+// particles; lane loads (sim/kernels/grid_common.h) read up to 15 floats past the last particle.
+inline ParticleLayout layout_for(std::size_t n) {
+  ParticleLayout l;
+  l.n = n;
+  l.tile = static_cast<cl_uint>(std::max<std::size_t>(256, (n / 32 + 255) / 256 * 256));
+  l.ntiles = static_cast<cl_uint>((n + l.tile - 1) / l.tile);
+  l.stride = static_cast<cl_uint>((n + 16 + 15) / 16 * 16);
+  return l;
+}
+
+// The handles of the core fields (core_fields() in sim/particles.h), which most stages read.
+struct CoreFields {
+  ParticleStore::Field position = 0, velocity = 0, density = 0, phase = 0, material = 0, id = 0;
+};
+
+}  // namespace thaw
