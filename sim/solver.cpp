@@ -36,8 +36,6 @@ std::vector<std::string> with_prelude(std::initializer_list<std::string> files) 
   return all;
 }
 
-cl::NDRange global_for(std::size_t n) { return cl::NDRange(std::max<std::size_t>(n, 1)); }
-
 std::vector<float> rigid_mass_scales(const Scene& scene, double rest_density) {
   std::vector<float> out;
   for (const Material& m : scene.materials) out.push_back(static_cast<float>(mass_scale(m, rest_density)));
@@ -78,22 +76,24 @@ SolverConstants derive_constants(const Scene& scene) {
   k.support = static_cast<float>(s.support_ratio * scene.spacing);
   k.smoothing = 0.5f * k.support;
 
-  int fluid_material = -1;
-  for (std::size_t b = 0; b < scene.fluids.size(); ++b) {
-    const int m = scene.fluids[b].material;
-    if (fluid_material >= 0 && scene.materials[m].density != scene.materials[fluid_material].density)
-      throw SceneError("fluids[" + std::to_string(b) + "].material",
-                       "every fluid block must have the same rest density in this solver ('" +
-                           scene.materials[m].name + "' differs from '" +
-                           scene.materials[fluid_material].name + "')");
-    if (fluid_material < 0) fluid_material = m;
-  }
-  // A scene of ice alone: its water is the fluid that appears.
+  // The first fluid block's material (or, in a scene of ice alone, the water it melts into) sets the rest
+  // density that boundary particles carry (Akinci 2012) and the stiffness scale; each fluid's own
+  // properties are rows of the flow table (material_flow_table in sim/fluid_stage.h).
+  int fluid_material = scene.fluids.empty() ? -1 : scene.fluids.front().material;
   for (const auto& c : scene.ice)
     if (fluid_material < 0) fluid_material = scene.materials[static_cast<std::size_t>(c.material)].partner;
   const Material* fluid = fluid_material >= 0 ? &scene.materials[fluid_material] : nullptr;
   k.rest_density = static_cast<float>(fluid ? fluid->density : 1000.0);
-  k.kinematic_viscosity = static_cast<float>(fluid ? fluid->viscosity / fluid->density : 0.0);
+  // The viscous limit on dt takes the largest kinematic viscosity of any fluid present or melted into.
+  double nu = 0;
+  auto consider = [&](int m) {
+    if (m < 0) return;
+    const Material& mat = scene.materials[static_cast<std::size_t>(m)];
+    if (mat.kind == "fluid") nu = std::max(nu, double(static_cast<float>(mat.viscosity / mat.density)));
+  };
+  for (const auto& f : scene.fluids) consider(f.material);
+  for (const auto& c : scene.ice) consider(scene.materials[static_cast<std::size_t>(c.material)].partner);
+  k.kinematic_viscosity = static_cast<float>(nu);
 
   // Reference speed: free fall from the highest fluid or ice to the bottom of the domain, or the fastest
   // initial velocity, whichever is larger.
@@ -194,15 +194,8 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   opts << " -DTHAW_REACH=" << kGridReach << " -DTHAW_VW=" << kLanes;
   grid_ = std::make_unique<NeighbourGrid>(cl, scene_, k_.support, kGridReach, opts.str(), layout_, lo, hi);
   const auto boundary = cl.build(with_prelude({"boundary.cl"}), opts.str());
-  const auto density = cl.build(with_prelude({"density.cl"}), opts.str());
-  const auto forces = cl.build(with_prelude({"forces.cl"}), opts.str());
-  const auto integrate = cl.build(with_prelude({"integrate.cl", "step_limits.cl"}), opts.str());
   k_psi_ = cl::Kernel(boundary, "boundary_psi");
   k_set_mass_ = cl::Kernel(boundary, "set_mass");
-  k_density_ = cl::Kernel(density, "density");
-  k_forces_ = cl::Kernel(forces, "forces");
-  k_limits_ = cl::Kernel(integrate, "step_limits");
-  k_integrate_ = cl::Kernel(integrate, "integrate");
 
   auto& ctx = cl.context();
   const std::size_t n = std::max<std::size_t>(n_, 1);
@@ -223,16 +216,11 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   heat_reason_ = plan.reason;
   if (plan.build)
     heat_ = std::make_unique<HeatStage>(cl, store_, f_, scene_, plan, k_, opts.str(), layout_, lo, hi);
-  state_ = buf(n * 16);
-  accel_ = buf(n * 16);
+  if (scene.solver.flow)
+    fluid_ = std::make_unique<FluidStage>(cl, store_, f_, scene_, k_, opts.str(), layout_);
   scratch_ = buf(n * 4);
-  derived_ = buf(std::size_t(layout_.stride) * 3 * 4);
-  // The padding past the last particle is read by masked lanes only; keep it finite anyway.
-  cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(layout_.stride) * 3 * 4);
-  table_ = material_thermal_table(scene, k_.rest_density);
   clamped_ = buf(4);
-  limits_f_ = buf(std::size_t(std::max<std::uint32_t>(layout_.ntiles, 1)) * 8);
-  limits_i_ = buf(std::size_t(std::max<std::uint32_t>(layout_.ntiles, 1)) * 8);
+  table_ = material_thermal_table(scene, k_.rest_density);
 
   // Boundary particles sampled by sample_scene() carry no mass yet: their Psi = rho0 V_b comes from
   // the solver's rest density. Walls here sit on the fluid lattice and fill the kernel support, so the
@@ -277,7 +265,7 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
 Solver::~Solver() = default;
 
 ParticleBuffers Solver::buffers() const {
-  return {store_[f_.position], store_[f_.velocity],    state_,
+  return {store_[f_.position], store_[f_.velocity],    fluid_->state(),
           store_[f_.phase],    store_[f_.material],    store_[f_.id],
           grid_->cell_start(), cl_grid(grid_->info()), static_cast<std::uint32_t>(n_)};
 }
@@ -325,26 +313,11 @@ void Solver::compute_boundary_psi() {
 }
 
 void Solver::compute_density() {
-  if (n_ == 0) return;
-  const ClGrid g = cl_grid(grid_->info());
-  const auto& s = scene_.solver;
-  set_args(k_density_, store_[f_.position], grid_->soa(), layout_.stride, store_[f_.phase],
-           grid_->cell_start(), g, k_.support, k_.rest_density, k_.stiffness, static_cast<float>(s.gamma),
-           k_.visc_fluid, k_.visc_boundary, store_[f_.density], state_, derived_, static_cast<cl_uint>(n_));
-  launch(cl_.queue(), k_density_, n_);
+  if (fluid_) fluid_->density(neighbours());
 }
 
 void Solver::compute_forces() {
-  if (n_ == 0) return;
-  const ClGrid g = cl_grid(grid_->info());
-  const float h = k_.smoothing;
-  const cl_float4 gravity{
-      {float(scene_.gravity.x()), float(scene_.gravity.y()), float(scene_.gravity.z()), 0.f}};
-  set_args(k_forces_, store_[f_.position], store_[f_.velocity], grid_->soa(), derived_, layout_.stride,
-           state_, store_[f_.phase], grid_->cell_start(), g, k_.support, gravity, 0.01f * h * h,
-           k_.rest_density, k_.repulsion, k_.repulsion_range, k_.repulsion_damping, accel_,
-           static_cast<cl_uint>(n_));
-  launch(cl_.queue(), k_forces_, n_);
+  if (fluid_) fluid_->forces(neighbours());
 }
 
 double Solver::heat_time_step() const {
@@ -364,25 +337,9 @@ double Solver::choose_time_step() {
     }
     return dt;
   }
-  double vmax2 = 0, amax2 = 0;
-  std::uint32_t fastest = 0, bad = 0xffffffffu;
-  if (n_ > 0) {
-    set_args(k_limits_, store_[f_.position], store_[f_.velocity], accel_, store_[f_.phase], limits_f_,
-             limits_i_, static_cast<cl_uint>(n_), layout_.tile);
-    cl_.queue().enqueueNDRangeKernel(k_limits_, cl::NullRange, global_for(layout_.ntiles));
-    std::vector<cl_float2> f(layout_.ntiles);
-    std::vector<cl_uint2> ix(layout_.ntiles);
-    cl_.queue().enqueueReadBuffer(limits_f_, CL_FALSE, 0, layout_.ntiles * 8, f.data());
-    cl_.queue().enqueueReadBuffer(limits_i_, CL_TRUE, 0, layout_.ntiles * 8, ix.data());
-    for (std::uint32_t t = 0; t < layout_.ntiles; ++t) {
-      if (f[t].s[0] > vmax2) {
-        vmax2 = f[t].s[0];
-        fastest = ix[t].s[0];
-      }
-      amax2 = std::max(amax2, double(f[t].s[1]));
-      bad = std::min(bad, ix[t].s[1]);
-    }
-  }
+  const FlowLimits lim = fluid_->limits();
+  const double vmax2 = lim.vmax2, amax2 = lim.amax2;
+  const std::uint32_t fastest = lim.fastest, bad = lim.bad;
   auto particle_at = [&](std::uint32_t i) {
     Float4 x, v;
     std::uint32_t id = 0;
@@ -462,10 +419,7 @@ std::vector<Float4> Solver::ice_forces() const {
 }
 
 void Solver::integrate(double dt) {
-  if (n_ == 0) return;
-  set_args(k_integrate_, store_[f_.position], store_[f_.velocity], accel_, store_[f_.phase],
-           static_cast<float>(dt), static_cast<float>(1.0 / (1.0 + damping_ * dt)), static_cast<cl_uint>(n_));
-  launch(cl_.queue(), k_integrate_, n_);
+  if (fluid_) fluid_->integrate(dt, 1.0 / (1.0 + damping_ * dt));
 }
 
 void Solver::step() {
@@ -631,7 +585,7 @@ std::vector<float> Solver::densities() const {
 
 std::vector<Float4> Solver::pressure_state() const {
   std::vector<Float4> out(n_);
-  if (n_) cl_.queue().enqueueReadBuffer(state_, CL_TRUE, 0, n_ * 16, out.data());
+  if (n_ && fluid_) cl_.queue().enqueueReadBuffer(fluid_->state(), CL_TRUE, 0, n_ * 16, out.data());
   return out;
 }
 

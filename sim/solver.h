@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sim/cl_runtime.h"
+#include "sim/fluid_stage.h"
 #include "sim/heat_stage.h"
 #include "sim/kernels/thermal_law.h"
 #include "sim/neighbour_grid.h"
@@ -171,11 +172,12 @@ class Solver {
   CoreFields f_;
   std::unique_ptr<NeighbourGrid> grid_;
   bool grid_built_ = false;
-  // The fluid passes (density, forces, time-step limits, integration): pressure state, accelerations,
-  // the density pass's pair coefficients (read by the forces pass), one float of scratch per particle,
-  // particles clamped into the domain, per-tile limits.
-  cl::Buffer state_, accel_, derived_, scratch_, clamped_, limits_f_, limits_i_;
-  cl::Kernel k_psi_, k_set_mass_, k_density_, k_forces_, k_limits_, k_integrate_;
+  // The water's passes (sim/fluid_stage.h), built only for scenes with flow.
+  std::unique_ptr<FluidStage> fluid_;
+  // One float of scratch per particle (the boundary volumes at the start), particles clamped back into
+  // the domain, and the kernels that give boundary particles their mass.
+  cl::Buffer scratch_, clamped_;
+  cl::Kernel k_psi_, k_set_mass_;
 
   // Heat (sim/heat_stage.h), built only when plan_heat says the scene needs it. Without it the enthalpy
   // never changes and stays on the host, by particle id (fixed_enthalpy_). The budget is the run's

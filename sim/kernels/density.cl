@@ -6,13 +6,17 @@
  * forces pass's pair terms: derived = (k_j m_j / rho_j, m_j p_j / rho_j^2, solid ? m_j : 0) blocks,
  * k_j the viscosity coefficient of the particle's kind (fluid or boundary). */
 
-kernel void density(global const float4* pos, global const float* soa, const uint stride,
-                    global const uchar* phase, global const uint* cell_start, const Grid g, const float H,
-                    const float rho0, const float B, const float gamma_eos, const float visc_fluid,
-                    const float visc_boundary, global float* density, global float4* state,
-                    global float* derived, const uint n) {
+kernel void density(global const float4* pos, global const float* soa, global const uchar* phase,
+                    global const uchar* material, global const MaterialFlow* flow, global const uint* cell_start,
+                    const Grid g, const DensityParams P, global float* density, global float4* state,
+                    global float* derived) {
   const uint i = get_global_id(0);
+  const uint n = P.n, stride = P.stride;
   if (i >= n) return;
+  const float H = P.support;
+  /* The particle's material's rest density and stiffness (fluid_params.h). */
+  const MaterialFlow mf = flow[material[i]];
+  const float rho0 = mf.rest_density, B = mf.stiffness;
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
@@ -42,7 +46,7 @@ kernel void density(global const float4* pos, global const float* soa, const uin
   const float x = rho / rho0, x2 = x * x, x4 = x2 * x2;
   float p = B * (x4 * x2 * x - 1.0f);
 #else
-  float p = B * (powr(rho / rho0, gamma_eos) - 1.0f);
+  float p = B * (powr(rho / rho0, P.gamma) - 1.0f);
 #endif
 #else
   /* Linear: p = c^2 (rho - rho0), B passed as c^2 * rho0. */
@@ -54,7 +58,7 @@ kernel void density(global const float4* pos, global const float* soa, const uin
   const float dp = p / (rho * rho);
   density[i] = rho;
   state[i] = (float4)(rho, dp, boundary ? 1.0f : 0.0f, p);
-  derived[i] = (boundary ? visc_boundary : visc_fluid) * pi.w / rho;
+  derived[i] = (boundary ? P.visc_boundary : mf.viscosity) * pi.w / rho;
   derived[stride + i] = pi.w * dp;
   derived[2 * stride + i] = phase[i] == THAW_PHASE_SOLID ? pi.w : 0.0f;
 }

@@ -33,12 +33,14 @@ floatV repulsion(const floatV r, const floatV vd, const float r0, const float d)
 }
 
 kernel void forces(global const float4* pos, global const float4* vel, global const float* soa,
-                   global const float* derived, const uint stride, global const float4* state,
-                   global const uchar* phase, global const uint* cell_start, const Grid g, const float H,
-                   const float4 gravity, const float eps2, const float rho0, const float rep_k,
-                   const float rep_r0, const float rep_d, global float4* accel, const uint n) {
+                   global const float* derived, global const float4* state, global const uchar* phase,
+                   global const uchar* material, global const MaterialFlow* flow, global const uint* cell_start,
+                   const Grid g, const ForcesParams P, global float4* accel) {
   const uint i = get_global_id(0);
+  const uint n = P.n, stride = P.stride;
   if (i >= n) return;
+  const float H = P.support, eps2 = P.eps2, rep_k = P.rep_k, rep_r0 = P.rep_r0, rep_d = P.rep_d;
+  const float4 gravity = (float4)(P.gravity_x, P.gravity_y, P.gravity_z, 0.0f);
   if (THAW_IS_STATIC(phase[i])) {
     accel[i] = (float4)(0.0f);
     return;
@@ -46,7 +48,7 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
   const float4 pi = pos[i];
   const float4 vi = vel[i];
   const float dpi = state[i].y;
-  const float visc_i = rho0 / state[i].x; /* the viscous pair term's rho0 / rho_i */
+  const float visc_i = flow[material[i]].rest_density / state[i].x; /* the viscous pair term's rho0 / rho_i */
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
   const float inv_H = 1.0f / H;

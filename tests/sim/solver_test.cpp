@@ -395,5 +395,42 @@ TEST_F(SolverTest, LoneDropsRestOnAWallWithoutTheClamp) {
   EXPECT_EQ(solver.clamped(), 0u);
 }
 
+// Flow properties are a table per material (sim/fluid_stage.h): a boundary material carries the rest
+// density of the fluid it bounds; the viscous time-step limit takes the most viscous fluid; two rest
+// densities are refused, naming the block, until the air model lands.
+TEST_F(SolverTest, FlowPropertiesArePerMaterialAndTwoRestDensitiesAreRefused) {
+  Scene scene =
+      dam_break({"materials.syrup={\"kind\": \"fluid\", \"density\": 1000, \"viscosity\": 0.5, "
+                 "\"conductivity\": 0.5, \"specific_heat\": 3000}"});
+  const int water = scene.fluids.at(0).material;
+  int syrup = -1, wall = scene.wall_material;
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].name == "syrup") syrup = int(m);
+  ASSERT_GE(syrup, 0);
+  ASSERT_GE(wall, 0);
+  FluidBlock second = scene.fluids.at(0);
+  second.material = syrup;
+  second.box.min.z() = second.box.max.z() + 0.1;
+  second.box.max.z() = second.box.min.z() + 0.1;
+  scene.fluids.push_back(second);
+  const SolverConstants k = derive_constants(scene);
+  EXPECT_FLOAT_EQ(k.kinematic_viscosity, 0.5f / 1000.0f) << "the most viscous fluid sets the viscous limit";
+  const std::vector<fluid::MaterialFlow> table = material_flow_table(scene, k);
+  ASSERT_EQ(table.size(), scene.materials.size());
+  EXPECT_EQ(table[std::size_t(wall)].rest_density, table[std::size_t(water)].rest_density);
+  EXPECT_GT(table[std::size_t(syrup)].viscosity, table[std::size_t(water)].viscosity);
+  Solver both(cl(), scene, initial_state(scene));
+  both.step();
+
+  scene.materials[std::size_t(syrup)].density = 1100;
+  try {
+    Solver refused(cl(), scene, initial_state(scene));
+    FAIL() << "two rest densities were accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path(), "fluids[1].material");
+    EXPECT_NE(std::string(e.what()).find("two rest densities"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace thaw

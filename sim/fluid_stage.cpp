@@ -1,0 +1,139 @@
+#include "sim/fluid_stage.h"
+
+#include <algorithm>
+
+#include "sim/cl_launch.h"
+#include "sim/error.h"
+#include "sim/solver.h"
+
+namespace thaw {
+
+std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k) {
+  int first = -1;
+  for (std::size_t b = 0; b < scene.fluids.size(); ++b) {
+    const int m = scene.fluids[b].material;
+    if (first >= 0 && scene.materials[m].density != scene.materials[first].density)
+      throw SceneError("fluids[" + std::to_string(b) + "].material",
+                       "fluids of two rest densities ('" + scene.materials[m].name + "' " +
+                           std::to_string(scene.materials[m].density) + " kg/m^3, '" +
+                           scene.materials[first].name + "' " +
+                           std::to_string(scene.materials[first].density) +
+                           " kg/m^3) need the multiphase boundaries and time step of the air model, which "
+                           "this build does not have yet; give every fluid block the same rest density");
+    if (first < 0) first = m;
+  }
+  const double c = k.sound_speed, c2 = c * c, h = k.smoothing;
+  const auto& s = scene.solver;
+  std::vector<fluid::MaterialFlow> table;
+  for (const Material& m : scene.materials) {
+    fluid::MaterialFlow f{};
+    // A boundary material carries rho0 V of the fluid it bounds: the fluid's row (Akinci 2012).
+    const bool fluid = m.kind == "fluid";
+    // In float first, as the kernels see them (and as the single-fluid constants always were).
+    const double rho0 = fluid ? double(static_cast<float>(m.density)) : double(k.rest_density);
+    const double nu =
+        fluid ? double(static_cast<float>(m.viscosity / m.density)) : double(k.kinematic_viscosity);
+    f.rest_density = static_cast<float>(rho0);
+    f.stiffness = static_cast<float>(s.eos == "tait" ? rho0 * c2 / s.gamma : rho0 * c2);
+    // Monaghan 2005 eq. 4.8: 2 (d + 2) nu = 10 nu in 3-D, plus the artificial part alpha c h.
+    f.viscosity = static_cast<float>(s.artificial_viscosity * c * h + 10.0 * nu);
+    f.sound_speed = static_cast<float>(c);
+    table.push_back(f);
+  }
+  return table;
+}
+
+FluidStage::FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
+                       const SolverConstants& k, const std::string& build_options,
+                       const ParticleLayout& layout)
+    : cl_(cl), store_(store), f_(core), layout_(layout) {
+  const std::vector<std::string> prelude = {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h"};
+  auto with = [&](std::initializer_list<std::string> files) {
+    std::vector<std::string> all = prelude;
+    all.insert(all.end(), files);
+    return all;
+  };
+  k_density_ = cl::Kernel(cl.build(with({"density.cl"}), build_options), "density");
+  k_forces_ = cl::Kernel(cl.build(with({"forces.cl"}), build_options), "forces");
+  const auto integrate = cl.build(with({"integrate.cl", "step_limits.cl"}), build_options);
+  k_limits_ = cl::Kernel(integrate, "step_limits");
+  k_integrate_ = cl::Kernel(integrate, "integrate");
+
+  const std::vector<fluid::MaterialFlow> table = material_flow_table(scene, k);
+  auto& ctx = cl.context();
+  flow_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(fluid::MaterialFlow),
+                     const_cast<fluid::MaterialFlow*>(table.data()));
+  const std::size_t n = std::max<std::size_t>(layout.n, 1);
+  const std::size_t tiles = std::max<cl_uint>(layout.ntiles, 1);
+  auto buf = [&](std::size_t bytes) {
+    return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
+  };
+  state_ = buf(n * 16);
+  accel_ = buf(n * 16);
+  derived_ = buf(std::size_t(layout.stride) * 3 * 4);
+  // The padding past the last particle is read by masked lanes only; keep it finite anyway.
+  cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(layout.stride) * 3 * 4);
+  limits_f_ = buf(tiles * 8);
+  limits_i_ = buf(tiles * 8);
+
+  density_params_.support = k.support;
+  density_params_.gamma = static_cast<float>(scene.solver.gamma);
+  density_params_.visc_boundary = k.visc_boundary;
+  density_params_.stride = layout.stride;
+  density_params_.n = static_cast<cl_uint>(layout.n);
+  forces_params_.support = k.support;
+  forces_params_.eps2 = 0.01f * k.smoothing * k.smoothing;
+  forces_params_.gravity_x = float(scene.gravity.x());
+  forces_params_.gravity_y = float(scene.gravity.y());
+  forces_params_.gravity_z = float(scene.gravity.z());
+  forces_params_.rep_k = k.repulsion;
+  forces_params_.rep_r0 = k.repulsion_range;
+  forces_params_.rep_d = k.repulsion_damping;
+  forces_params_.stride = layout.stride;
+  forces_params_.n = static_cast<cl_uint>(layout.n);
+}
+
+void FluidStage::density(const NeighbourView& nv) {
+  if (layout_.n == 0) return;
+  set_args(k_density_, store_[f_.position], nv.soa, store_[f_.phase], store_[f_.material], flow_,
+           nv.cell_start, nv.grid, density_params_, store_[f_.density], state_, derived_);
+  launch(cl_.queue(), k_density_, layout_.n);
+}
+
+void FluidStage::forces(const NeighbourView& nv) {
+  if (layout_.n == 0) return;
+  set_args(k_forces_, store_[f_.position], store_[f_.velocity], nv.soa, derived_, state_, store_[f_.phase],
+           store_[f_.material], flow_, nv.cell_start, nv.grid, forces_params_, accel_);
+  launch(cl_.queue(), k_forces_, layout_.n);
+}
+
+FlowLimits FluidStage::limits() {
+  FlowLimits out;
+  if (layout_.n == 0) return out;
+  auto& q = cl_.queue();
+  set_args(k_limits_, store_[f_.position], store_[f_.velocity], accel_, store_[f_.phase], limits_f_,
+           limits_i_, static_cast<cl_uint>(layout_.n), layout_.tile);
+  q.enqueueNDRangeKernel(k_limits_, cl::NullRange, cl::NDRange(std::max<cl_uint>(layout_.ntiles, 1)));
+  std::vector<cl_float2> f(layout_.ntiles);
+  std::vector<cl_uint2> ix(layout_.ntiles);
+  q.enqueueReadBuffer(limits_f_, CL_FALSE, 0, layout_.ntiles * 8, f.data());
+  q.enqueueReadBuffer(limits_i_, CL_TRUE, 0, layout_.ntiles * 8, ix.data());
+  for (cl_uint t = 0; t < layout_.ntiles; ++t) {
+    if (f[t].s[0] > out.vmax2) {
+      out.vmax2 = f[t].s[0];
+      out.fastest = ix[t].s[0];
+    }
+    out.amax2 = std::max(out.amax2, double(f[t].s[1]));
+    out.bad = std::min(out.bad, ix[t].s[1]);
+  }
+  return out;
+}
+
+void FluidStage::integrate(double dt, double damping_factor) {
+  if (layout_.n == 0) return;
+  set_args(k_integrate_, store_[f_.position], store_[f_.velocity], accel_, store_[f_.phase],
+           static_cast<float>(dt), static_cast<float>(damping_factor), static_cast<cl_uint>(layout_.n));
+  launch(cl_.queue(), k_integrate_, layout_.n);
+}
+
+}  // namespace thaw

@@ -1,0 +1,61 @@
+#pragma once
+// The water's passes, weakly compressible SPH: summation density with the equation of state (Tait:
+// Monaghan 1994, Becker & Teschner 2007; or linear), the forces (symmetric pressure, Monaghan 2005
+// viscosity, gravity, the boundary push; sim/kernels/forces.cl), the per-tile limits of the adaptive
+// time step, and symplectic Euler integration. Boundary particles (walls, solids, ice) enter as Akinci
+// et al. 2012 boundaries. Flow properties come per material from a device table (MaterialFlow in
+// sim/kernels/fluid_params.h), so a second fluid is a row of data; built only for scenes with flow.
+#include <CL/opencl.hpp>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/cl_runtime.h"
+#include "sim/kernels/fluid_params.h"
+#include "sim/particle_store.h"
+#include "sim/scene.h"
+#include "sim/stage.h"
+
+namespace thaw {
+
+struct SolverConstants;
+
+// Each material's flow properties, one per Scene::materials (fluid_params.h). Throws SceneError naming
+// the fluid block when the scene has fluids of two rest densities: the passes take them from the table,
+// but the boundaries (Akinci 2012) and the time step still assume one fluid until air lands.
+std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k);
+
+// The fastest particle and largest acceleration of the last forces pass, from the per-tile limits.
+struct FlowLimits {
+  double vmax2 = 0, amax2 = 0;
+  std::uint32_t fastest = 0;        // the fastest particle's index (sorted order)
+  std::uint32_t bad = 0xffffffffu;  // the first particle with a non-finite state (bit 31: acceleration only)
+};
+
+class FluidStage {
+ public:
+  FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
+             const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout);
+
+  void density(const NeighbourView& nv);
+  void forces(const NeighbourView& nv);
+  FlowLimits limits();
+  // Symplectic Euler over dt, velocities scaled by damping_factor (1: none).
+  void integrate(double dt, double damping_factor);
+
+  // Per particle: (rho, p / rho^2, is_boundary, p) from the density pass; accelerations from forces.
+  const cl::Buffer& state() const { return state_; }
+  const cl::Buffer& accel() const { return accel_; }
+
+ private:
+  ClRuntime& cl_;
+  ParticleStore& store_;
+  CoreFields f_;
+  ParticleLayout layout_;
+  fluid::DensityParams density_params_{};
+  fluid::ForcesParams forces_params_{};
+  cl::Kernel k_density_, k_forces_, k_limits_, k_integrate_;
+  cl::Buffer flow_, state_, accel_, derived_, limits_f_, limits_i_;
+};
+
+}  // namespace thaw
