@@ -1,5 +1,5 @@
 #pragma once
-// The renderer's OpenGL ES context, with no window and no display server (DESIGN.md, Renderer): an EGL
+// The renderer's OpenGL ES context, with no window and no display server (docs/ARCHITECTURE.md, Renderer): an EGL
 // display from a GPU through EGL_EXT_platform_device (NVIDIA), else Mesa's surfaceless platform
 // (llvmpipe here), and a context current on the thread that created it. The server's render thread
 // owns one; GL calls from any other thread are errors.

@@ -1,6 +1,6 @@
 #pragma once
 // What the renderer draws: a read-only copy of the particles taken between simulation steps, so that
-// rendering never touches the simulation's buffers (DESIGN.md: render reads a snapshot).
+// rendering never touches the simulation's buffers (docs/ARCHITECTURE.md: render reads a snapshot).
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>

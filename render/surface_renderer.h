@@ -1,12 +1,12 @@
 #pragma once
-// The metaball view (DESIGN.md, Renderer): the iso-surfaces of the ice, water and solid density fields,
+// The metaball view (docs/ARCHITECTURE.md, Renderer): the iso-surfaces of the ice, water and solid density fields,
 // ray-marched in a fragment shader (render/shaders/surface.frag) into an off-screen RGBA8 framebuffer
 // and read back as an Image.
 //
 // What goes to the GPU per frame, and why:
 //   u_field   R32F, one node per texel: the max of the three phases. Its iso-surface is the union of
 //             the phases' surfaces, so the march reads one texture per step (a 32-bit float fetch is the
-//             cheapest on llvmpipe; DESIGN.md, machine facts).
+//             cheapest on llvmpipe; docs/ARCHITECTURE.md, machine facts).
 //   u_phases  RGBA8: ice, water, solid clamped to [0, 1]; read only at hits and inside ice and water to
 //             tell the phases apart, where 8 bits around iso are plenty.
 //   u_blocks  RGBA32F, one texel per block of kBlock^3 cells. R: empty-space skipping, the Chebyshev

@@ -1,5 +1,5 @@
 #pragma once
-// The render thread of `thaw serve` (DESIGN.md, Server): it owns the EGL context (created on this thread,
+// The render thread of `thaw serve` (docs/ARCHITECTURE.md, Server): it owns the EGL context (created on this thread,
 // the only one that may use it), renders the session's newest snapshot in the current view, encodes it
 // to JPEG once for every viewer and publishes the newest frame; the network loop takes it from there.
 // Frames are never queued: a snapshot that arrives while a frame is being rendered replaces any older

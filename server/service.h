@@ -1,5 +1,5 @@
 #pragma once
-// `thaw serve`'s glue: the three parts and their hand-offs (DESIGN.md, Server). The network loop
+// `thaw serve`'s glue: the three parts and their hand-offs (docs/ARCHITECTURE.md, Server). The network loop
 // (WsServer) hands each client's text to this service on the loop's thread; the service checks it
 // (protocol::parse, the client's role, its rate), answers presentation commands from the render worker,
 // and queues simulation commands on the Session, whose answers come back from the session's thread and

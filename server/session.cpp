@@ -53,7 +53,7 @@ Json lamp_json(const Lamp& l) {
           {"photons", l.photons}};
 }
 
-// State names become file names in the state folder: nothing that could leave it (DESIGN.md: the
+// State names become file names in the state folder: nothing that could leave it (docs/ARCHITECTURE.md: the
 // protocol checks this too; the session does not rely on its caller for what touches the disk).
 bool valid_state_name(const std::string& name) {
   if (name.empty() || name.size() > 64) return false;

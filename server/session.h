@@ -1,5 +1,5 @@
 #pragma once
-// The simulation thread of `thaw serve` (DESIGN.md, Server): it owns the Solver, applies the commands the
+// The simulation thread of `thaw serve` (docs/ARCHITECTURE.md, Server): it owns the Solver, applies the commands the
 // network loop queues between two steps, and publishes what the other threads read — a render snapshot
 // and a stats event — by swapping shared pointers under a mutex. It never waits on a consumer: a reader
 // takes the newest value when it likes, and a slow one simply misses intermediate ones.

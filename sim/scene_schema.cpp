@@ -247,7 +247,7 @@ const Field& scene_schema() {
                          "4)")
                       .def("iwasaki2010"),
               },
-              "Heat transfer and phase change (Iwasaki et al. 2010; DESIGN.md Numerics)."),
+              "Heat transfer and phase change (Iwasaki et al. 2010; docs/ARCHITECTURE.md Numerics)."),
           object(
               "ambient",
               {
@@ -268,39 +268,39 @@ const Field& scene_schema() {
                       .client_settable(),
               },
               "Still air around the scene (the mode without air particles)."),
-          map_of(
-              "materials", "<name>",
-              {
-                  choice("kind", {"fluid", "solid", "ice"},
-                         "Fluid particles move; solids are static boundaries; ice stays in place and melts "
-                         "into its melts_into fluid"),
-                  number("density",
-                         "Rest density; 0.01 is below any real gas (1e-300 gave particles no mass)")
-                      .in("kg/m^3")
-                      .at_least(0.01)
-                      .at_most(1e5),
-                  number("viscosity", "Dynamic viscosity (fluids)").in("Pa s").def(0.0).at_least(0),
-                  number("conductivity", "Thermal conductivity k").in("W/m/K").at_least(0).at_most(1e4),
-                  number("specific_heat", "Specific heat capacity c; real materials have 100 or more")
-                      .in("J/kg/K")
-                      .at_least(1)
-                      .at_most(1e6),
-                  text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
-                      .when("kind", "ice"),
-                  number("latent_heat", "Latent heat of fusion L")
-                      .in("J/kg")
-                      .def(334000.0)
-                      .above(0)
-                      .at_most(1e8)
-                      .when("kind", "ice"),
-                  number("melting_point", "Melting temperature T_m")
-                      .in("°C")
-                      .def(0.0)
-                      .above(-273.15)
-                      .at_most(3000)
-                      .when("kind", "ice"),
-              },
-              "Materials by name; objects refer to them by name.")
+          map_of("materials", "<name>",
+                 {
+                     choice("kind", {"fluid", "solid", "ice"},
+                            "Fluid particles move; solids are static boundaries; ice is rigid (held where it "
+                            "starts with motion fixed, a floating body with motion free) and melts into its "
+                            "melts_into fluid"),
+                     number("density",
+                            "Rest density; 0.01 is below any real gas (1e-300 gave particles no mass)")
+                         .in("kg/m^3")
+                         .at_least(0.01)
+                         .at_most(1e5),
+                     number("viscosity", "Dynamic viscosity (fluids)").in("Pa s").def(0.0).at_least(0),
+                     number("conductivity", "Thermal conductivity k").in("W/m/K").at_least(0).at_most(1e4),
+                     number("specific_heat", "Specific heat capacity c; real materials have 100 or more")
+                         .in("J/kg/K")
+                         .at_least(1)
+                         .at_most(1e6),
+                     text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
+                         .when("kind", "ice"),
+                     number("latent_heat", "Latent heat of fusion L")
+                         .in("J/kg")
+                         .def(334000.0)
+                         .above(0)
+                         .at_most(1e8)
+                         .when("kind", "ice"),
+                     number("melting_point", "Melting temperature T_m")
+                         .in("°C")
+                         .def(0.0)
+                         .above(-273.15)
+                         .at_most(3000)
+                         .when("kind", "ice"),
+                 },
+                 "Materials by name; objects refer to them by name.")
               .non_empty(),
           array_of("fluids",
                    {
@@ -431,7 +431,7 @@ const Field& scene_schema() {
                       .at_most(1),
               },
               "Hair dryers without air particles: a cone of warm, fast air that heats the exposed surface "
-              "inside it (sim/heat_sources.h has the model).")
+              "inside it (sim/kernels/dryer_model.h has the model).")
               .def(Json::array()),
       });
   return scene;

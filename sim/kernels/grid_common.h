@@ -12,11 +12,11 @@
 #define THAW_PHASE_ICE 1
 #define THAW_PHASE_SOLID 2
 #define THAW_PHASE_AIR 3
-/* Particles that do not move: static solids, and ice, which stays in place until rigid bodies land. The
- * fluid solver sees both as boundary particles. */
+/* Particles the fluid passes do not move: static solids, and ice (rigid ice moves its own particles:
+ * sim/rigid_ice.h). The fluid solver sees both as boundary particles. */
 #define THAW_IS_STATIC(ph) ((ph) == THAW_PHASE_SOLID || (ph) == THAW_PHASE_ICE)
 
-/* Must match ClGrid in sim/solver.cpp. */
+/* Must match ClGrid in sim/cl_grid.h. */
 typedef struct {
   float4 origin;    /* grid minimum corner; w unused */
   float4 inv_cell;  /* 1 / cell size along x, y, z (cubes, except along periodic axes); w unused */

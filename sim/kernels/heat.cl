@@ -4,7 +4,7 @@
  *
  * Conduction is the pairwise form of Cleary & Monaghan (1999, eq. 9; Brookshaw 1985) with the harmonic
  * mean of the two conductivities, not the kernel Laplacian of Iwasaki et al. (2010) eq. 1, which is off by
- * 10-20 % in effective diffusivity on lattices and unstable on disordered particles (VALIDATION.md sec. 1):
+ * 10-20 % in effective diffusivity on lattices and unstable on disordered particles (docs/VALIDATION-RESULTS.md, conduction):
  *   Q_i = 2 V_i sum_j V_j k_ij (T_i - T_j) (x_ij . grad W_ij) / (r_ij^2 + eta^2),
  *   k_ij = 2 k_i k_j / (k_i + k_j),
  * the heat flow into particle i [W]. Each pair's term is antisymmetric, so conduction conserves the total

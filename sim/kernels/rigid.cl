@@ -1,12 +1,12 @@
 /* Ice that moves (Iwasaki et al. 2010 sec. 5): every connected piece of ice is a rigid body driven by the
  * forces on its particles. This file holds the per-particle parts: the force on each ice particle of a
- * free body (from the water, and contacts with solids and other bodies), placing the particles where
- * their body has moved, and carrying the per-particle body data through the neighbour sort.
- * The host (sim/rigid_stage.cpp) sums the forces per body and integrates the bodies. */
+ * free body (from the water, and contacts with solids and other bodies) and placing the particles where
+ * their body has moved; the per-particle body and offset are declared fields, sorted with the rest
+ * (sim/particle_store.h). The host (sim/rigid_ice.cpp) sums the forces per body and integrates them. */
 
 #define THAW_NO_BODY 0xffffffffu
 
-/* Per body, as the host uploads it each step (must match ClBody in sim/rigid_stage.cpp): centre of
+/* Per body, as the host uploads it each step (must match ClBody in sim/rigid_ice.cpp): centre of
  * mass, the rows of the rotation body -> world, velocity of the centre, angular velocity; w of `centre`
  * is 1 for a free body, 0 for a fixed one. */
 typedef struct {

@@ -2,7 +2,7 @@
  * the host (scene sampling, metrics, tests), so that both sides convert with the same arithmetic.
  *
  * Each particle carries its specific enthalpy h [J/kg]; temperature and liquid fraction follow from it
- * (DESIGN.md, Numerics). For a material pair that melts and freezes (ice <-> water) h = 0 is the solid
+ * (docs/ARCHITECTURE.md, Numerics). For a material pair that melts and freezes (ice <-> water) h = 0 is the solid
  * at its melting point T_m:
  *   h < 0        solid,  T = T_m + h / c_solid,              liquid fraction 0
  *   0 <= h <= L  at the melting point, T = T_m,               liquid fraction h / L

@@ -1,4 +1,4 @@
-// Heat conduction (shared/VALIDATION.md §1): a 3-D Gaussian temperature pulse spreading in a still
+// Heat conduction (docs/VALIDATION-RESULTS.md): a 3-D Gaussian temperature pulse spreading in a still
 // medium, particles held in place (solver.flow = false). Reference: the exact solution
 // T = T_inf + A (s0^2/(s0^2 + 2 alpha t))^(3/2) exp(-r^2 / (2 (s0^2 + 2 alpha t))) with alpha = k/(rho c)
 // from the parameters. Metrics: the L2 error of T, the effective diffusivity from the growth of the

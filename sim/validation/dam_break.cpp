@@ -1,4 +1,4 @@
-// Dam break (shared/VALIDATION.md §4): a water column of width a and height 2a collapses in a tank.
+// Dam break (docs/VALIDATION-RESULTS.md): a water column of width a and height 2a collapses in a tank.
 // Reference: Martin & Moyce (1952), surge front Z/a against T* = t sqrt(2 g / a), dimensionless, so it
 // holds for any a and g; between their digitized points it is interpolated linearly.
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Floating ice (shared/VALIDATION.md §5): a square ice prism, breadth b, height H, free in a tank of
+// Floating ice (docs/VALIDATION-RESULTS.md): a square ice prism, breadth b, height H, free in a tank of
 // water, starts tilted by `tilt` degrees about y, its centre at the height of Archimedes' draft.
 // References, from the parameters:
 // - upright, the draft over the height is f = rho_ice / rho_water (Archimedes);

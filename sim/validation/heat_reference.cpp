@@ -108,7 +108,7 @@ NeumannStefan solve_neumann_stefan(ThermalPhase near, ThermalPhase far, double w
   NeumannStefan n{near, far, wall_temperature, initial_temperature, melt_temperature, latent_heat, 0.0};
   // Both cases give the Stefan condition rho_n L ds/dt = (heat conducted to the front through the near
   // phase) - (heat conducted away into the far phase) once temperatures enter as magnitudes; the far
-  // term's density ratio is 1 in VALIDATION.md's equal-density case.
+  // term's density ratio is 1 in docs/VALIDATION-RESULTS.md's equal-density case.
   const double st_near = near.specific_heat * std::abs(wall_temperature - melt_temperature) / latent_heat;
   const double st_far = far.density * far.specific_heat * std::abs(melt_temperature - initial_temperature) /
                         (near.density * latent_heat);

@@ -1,6 +1,6 @@
 #pragma once
 // Exact solutions of the heat equation that the conduction and phase-change validation cases compare
-// against (docs: VALIDATION.md sections 1 and 2). They are computed from the case's own parameters, so a
+// against (docs/VALIDATION-RESULTS.md: conduction and Stefan). They are computed from the case's own parameters, so a
 // case whose materials or temperatures are overridden still has its reference.
 
 namespace thaw {
@@ -22,7 +22,7 @@ struct ThermalPhase {
 //
 // Neither phase moves: with unequal densities this is the conduction-only model, in which a unit volume
 // that changes phase absorbs rho_near L (releases it when freezing). With equal densities, the case of
-// VALIDATION.md, it is the exact solution.
+// docs/VALIDATION-RESULTS.md, it is the exact solution.
 struct NeumannStefan {
   ThermalPhase near, far;
   double wall_temperature = 0, initial_temperature = 0, melt_temperature = 0, latent_heat = 0;
@@ -53,7 +53,7 @@ NeumannStefan solve_neumann_stefan(ThermalPhase near, ThermalPhase far, double w
 // exp(z^2) erfc(z), finite for all z >= 0 where erfc(z) itself underflows (z > 26.5).
 double erfcx(double z);
 
-// A Gaussian pulse of excess temperature in `dimensions` dimensions (VALIDATION.md section 1):
+// A Gaussian pulse of excess temperature in `dimensions` dimensions (docs/VALIDATION-RESULTS.md, conduction):
 //   T = T_inf + A (s0^2 / (s0^2 + 2 alpha t))^(d/2) exp(-|x|^2 / (2 (s0^2 + 2 alpha t))).
 // Its excess heat, integral of (T - T_inf) dV = A (2 pi s0^2)^(d/2), is constant, and its second moment
 // (integral of |x|^2 (T - T_inf) dV over the excess) is d variance(t): growth of the variance measures the

@@ -1,4 +1,4 @@
-// Hydrostatic column (shared/VALIDATION.md §3): water at rest in a walled tank.
+// Hydrostatic column (docs/VALIDATION-RESULTS.md): water at rest in a walled tank.
 // Reference: the exact hydrostatic profile of the weakly compressible fluid the solver models,
 // dp/dz = -g rho(p) with rho(p) from the scene's equation of state and the column's mass per area
 // rho0 H; it tends to rho0 g (H - z) as the speed of sound grows. The particles start on that

@@ -1,4 +1,4 @@
-// The Stefan problem (shared/VALIDATION.md §2): a slab x > 0, initially at initial_temperature, with the
+// The Stefan problem (docs/VALIDATION-RESULTS.md): a slab x > 0, initially at initial_temperature, with the
 // wall at x < 0 held at wall_temperature from t = 0. Melting when the wall is above the melting point and
 // the slab is ice at or below it; freezing when the wall is below and the slab is water at or above it.
 // Reference: Neumann's similarity solution for these parameters (sim/validation/heat_reference.h).

@@ -183,7 +183,7 @@ TEST(DensityField, RejectsBadInput) {
   EXPECT_THROW(build_density_fields(s, {}), Error);
 }
 
-// Not a pass/fail check: prints the build time so runs can be compared (DESIGN.md: CIC of 100k
+// Not a pass/fail check: prints the build time so runs can be compared (docs/ARCHITECTURE.md: CIC of 100k
 // particles into 128^3 took 22-32 ms on this machine).
 TEST(DensityField, BuildTimeAt128Cubed) {
   for (int count : {25000, 100000}) {

@@ -93,6 +93,24 @@ TEST(ThawCli, MissingSceneFileIsNamed) {
   EXPECT_NE(r.err.find(missing), std::string::npos) << describe(r);
 }
 
+TEST(ThawCli, EverySubcommandPrintsItsUsageWithHelpAndRunsNothing) {
+  TempDir dir("cli-help");
+  for (const char* cmd :
+       {"serve", "ctl", "run", "validate", "bench", "bench throughput", "render", "info", "scene-doc"}) {
+    // `run --help` once tried to load a scene named "--help"; with a scene before it, it would run.
+    const auto r = run_thaw(std::string(cmd) + " dam-break --help --steps 1000000", dir);
+    EXPECT_TRUE(r.exited && r.exit_code == 0) << cmd << ": " << describe(r);
+    const std::string first =
+        std::string("usage: thaw ") + std::string(cmd).substr(0, std::string(cmd).find(' '));
+    EXPECT_EQ(r.out.rfind(first, 0), 0u) << cmd << ": " << describe(r);
+    EXPECT_EQ(r.out.find("particles (water"), std::string::npos) << cmd << " ran: " << describe(r);
+  }
+  const auto all = run_thaw("--help", dir);
+  EXPECT_TRUE(all.exited && all.exit_code == 0) << describe(all);
+  for (const char* cmd : {"serve", "ctl", "run", "validate", "bench", "render", "info", "scene-doc"})
+    EXPECT_NE(all.out.find(std::string("  ") + cmd + " "), std::string::npos) << cmd;
+}
+
 TEST(ThawCli, ValidateListsTheCases) {
   TempDir dir("cli-validate");
   const auto r = run_thaw("validate --list", dir);

@@ -16,7 +16,7 @@ namespace {
 
 using testing::ClSuite;
 
-// Materials of VALIDATION.md (ice 917 kg/m^3, water 1000) plus a steel solid.
+// Materials of the validation cases (docs/VALIDATION-RESULTS.md): ice 917 kg/m^3, water 1000, and steel.
 Json materials() {
   return Json::parse(R"({
     "water": {"kind": "fluid", "density": 1000, "viscosity": 1e-3, "conductivity": 0.56, "specific_heat": 4217},

@@ -24,8 +24,9 @@ using testing::ClSuite;
 
 constexpr double kRho0 = 1000.0;
 
-// A scene without walls (every particle is fluid). Spacing 2^-5 m makes the cell (H / 2 with
-// H = 2 dx) and every domain face exact binary fractions, so "on a cell border" is exact.
+// A scene without walls (every particle is fluid). Spacing 2^-5 m makes the cell (H = 2 dx, one cell of
+// reach: NeighbourGrid in sim/neighbour_grid.h) and every domain face exact binary fractions, so "on a
+// cell border" is exact.
 Scene grid_scene(double spacing = 0.03125, Eigen::Vector3d max = {0.5, 0.375, 0.25}) {
   Json doc = {
       {"name", "neighbour-grid-test"},
@@ -34,7 +35,11 @@ Scene grid_scene(double spacing = 0.03125, Eigen::Vector3d max = {0.5, 0.375, 0.
       {"spacing", spacing},
       {"materials",
        {{"water",
-         {{"kind", "fluid"}, {"density", kRho0}, {"viscosity", 1e-3}, {"conductivity", 0.56}, {"specific_heat", 4217}}}}},
+         {{"kind", "fluid"},
+          {"density", kRho0},
+          {"viscosity", 1e-3},
+          {"conductivity", 0.56},
+          {"specific_heat", 4217}}}}},
       {"fluids",
        {{{"material", "water"}, {"box", {{"min", {0.0, 0.0, 0.0}}, {"max", {0.125, 0.125, 0.125}}}}}}},
   };
@@ -77,7 +82,7 @@ std::vector<Eigen::Vector3f> uniform_points(const Scene& s, std::size_t n, unsig
 // A few tight Gaussian clusters: hundreds of particles per cell, one cluster on a domain corner.
 std::vector<Eigen::Vector3f> clustered_points(const Scene& s, std::size_t n, unsigned seed) {
   std::mt19937 rng(seed);
-  const float cell = 0.5f * float(s.spacing * s.solver.support_ratio);
+  const float cell = 0.5f * float(s.spacing * s.solver.support_ratio);  // half a cell of H
   const Eigen::Vector3f lo = s.domain.min.cast<float>(), hi = s.domain.max.cast<float>();
   const std::vector<Eigen::Vector3f> centres = {
       lo + 0.3f * (hi - lo), lo + 0.7f * (hi - lo), {hi.x() * 0.5f, lo.y(), hi.z() * 0.4f}, hi};
@@ -93,6 +98,7 @@ std::vector<Eigen::Vector3f> clustered_points(const Scene& s, std::size_t n, uns
 // Points on the domain's faces, edges and corners and on cell borders, each coordinate exactly.
 std::vector<Eigen::Vector3f> boundary_points(const Scene& s, std::size_t n, unsigned seed) {
   std::mt19937 rng(seed);
+  // Borders every half cell of H: every cell border of the grid, and the midlines between them.
   const float cell = 0.5f * float(s.spacing * s.solver.support_ratio);
   std::vector<Eigen::Vector3f> out;
   // The eight corners, exactly.

@@ -1,5 +1,6 @@
-// The exact heat-conduction references: VALIDATION.md's printed values, the equations they solve, and
-// the conservation laws they obey, checked by quadrature that does not share their closed forms.
+// The exact heat-conduction references: the values the validation specification prints for its cases
+// (docs/VALIDATION-RESULTS.md quotes them), the equations they solve, and the conservation laws they obey,
+// checked by quadrature that does not share their closed forms.
 #include "sim/validation/heat_reference.h"
 
 #include <gtest/gtest.h>
@@ -15,7 +16,7 @@
 namespace thaw {
 namespace {
 
-// VALIDATION.md's materials at the equal density the Stefan case uses.
+// docs/VALIDATION-RESULTS.md's materials at the equal density the Stefan case uses.
 const ThermalPhase kWater{0.56, 4217.0, 1000.0};
 const ThermalPhase kIce{2.22, 2050.0, 1000.0};
 constexpr double kLatent = 334000.0;
@@ -28,7 +29,8 @@ double integrate(const std::function<double(double)>& f, double a, double b, int
   return sum * h / 3.0;
 }
 
-// The transcendental equation as VALIDATION.md prints it, with std::erf/erfc (moderate arguments only).
+// Neumann's transcendental equation for the front (docs/VALIDATION-RESULTS.md, Stefan), with std::erf/erfc
+// (moderate arguments only).
 double stefan_residual(const NeumannStefan& n, double lambda) {
   const double st_near =
       n.near.specific_heat * std::abs(n.wall_temperature - n.melt_temperature) / n.latent_heat;
