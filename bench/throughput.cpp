@@ -124,7 +124,7 @@ HeatComparison compare_heat(ClRuntime& cl, Solver& solver, const Scene& scene, c
   prm.eta2 = 0.01f * k.smoothing * k.smoothing;
   const float dx = static_cast<float>(scene.spacing);
   prm.exposed_r2 = 1.44f * dx * dx;
-  prm.wendland = scene.solver.kernel == "wendland_c2";
+  prm.wendland = scene.solver.kernel == KernelFunction::WendlandC2;
   prm.face_area = dx * dx;
   prm.ambient_temperature = static_cast<float>(scene.heat.ambient_temperature);
   prm.ambient_coefficient = static_cast<float>(scene.heat.ambient_coefficient);
@@ -208,8 +208,8 @@ Json bench_throughput(ClRuntime& cl, const ThroughputOptions& o, bool print) {
     prm.rho0 = k.rest_density;
     prm.B = k.stiffness;
     prm.gamma = static_cast<float>(scene.solver.gamma);
-    prm.tait = scene.solver.eos == "tait";
-    prm.wendland = scene.solver.kernel == "wendland_c2";
+    prm.tait = scene.solver.eos == Eos::Tait;
+    prm.wendland = scene.solver.kernel == KernelFunction::WendlandC2;
     prm.visc_fluid = k.visc_fluid;
     prm.visc_boundary = k.visc_boundary;
     ReferenceDensity lanes, scalar;

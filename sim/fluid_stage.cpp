@@ -28,13 +28,13 @@ std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const S
   for (const Material& m : scene.materials) {
     fluid::MaterialFlow f{};
     // A boundary material carries rho0 V of the fluid it bounds: the fluid's row (Akinci 2012).
-    const bool fluid = m.kind == "fluid";
+    const bool fluid = m.kind == MaterialKind::Fluid;
     // In float first, as the kernels see them (and as the single-fluid constants always were).
     const double rho0 = fluid ? double(static_cast<float>(m.density)) : double(k.rest_density);
     const double nu =
         fluid ? double(static_cast<float>(m.viscosity / m.density)) : double(k.kinematic_viscosity);
     f.rest_density = static_cast<float>(rho0);
-    f.stiffness = static_cast<float>(s.eos == "tait" ? rho0 * c2 / s.gamma : rho0 * c2);
+    f.stiffness = static_cast<float>(s.eos == Eos::Tait ? rho0 * c2 / s.gamma : rho0 * c2);
     // Monaghan 2005 eq. 4.8: 2 (d + 2) nu = 10 nu in 3-D, plus the artificial part alpha c h.
     f.viscosity = static_cast<float>(s.artificial_viscosity * c * h + 10.0 * nu);
     f.sound_speed = static_cast<float>(c);

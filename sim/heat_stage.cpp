@@ -30,7 +30,7 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
       layout_(layout) {
   enthalpy_ = store.add({"enthalpy", FieldType::Float32, 2});
 
-  std::string opts = build_options + " -DTHAW_EXPOSED_AREA=" + scene.heat.exposed_area;
+  std::string opts = build_options + " -DTHAW_EXPOSED_AREA=" + name(scene.heat.exposed_area);
   if (plan.ambient) opts += " -DTHAW_AMBIENT";
   if (plan.dryers) opts += " -DTHAW_DRYERS";
   if (plan.walls) opts += " -DTHAW_WALL_HEAT";

@@ -18,6 +18,35 @@
 
 namespace thaw {
 
+const char* name(MaterialKind k) {
+  switch (k) {
+    case MaterialKind::Fluid:
+      return "fluid";
+    case MaterialKind::Solid:
+      return "solid";
+    case MaterialKind::Ice:
+      return "ice";
+  }
+  return "?";
+}
+const char* name(KernelFunction k) {
+  return k == KernelFunction::WendlandC2 ? "wendland_c2" : "cubic_spline";
+}
+const char* name(Eos e) { return e == Eos::Tait ? "tait" : "linear"; }
+const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
+const char* name(ExposedArea) { return "iwasaki2010"; }
+
+namespace {
+// A choice the schema has already checked, as its enum.
+template <class E>
+E choice_of(const Json& value, std::initializer_list<E> options) {
+  const std::string text = value.get<std::string>();
+  for (E e : options)
+    if (text == name(e)) return e;
+  throw Error("'" + text + "' is not one of the choices (the schema should have refused it)");
+}
+}  // namespace
+
 namespace {
 
 // A sanity limit: beyond this a typo in `spacing` would exhaust memory before any error appears.
@@ -204,7 +233,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   s.solver = solver_settings_from_json(doc["solver"]);
   // The lattice sum sum_j dx^3 W is 1.034 for Wendland C2 at H = 2 dx and 1.003 at 3 dx (cubic spline:
   // 0.99997 at 2 dx; tests/sim/sph_kernel_test.cpp): below 3 dx a resting lattice starts compressed.
-  if (s.solver.kernel == "wendland_c2" && s.solver.support_ratio < 3.0)
+  if (s.solver.kernel == KernelFunction::WendlandC2 && s.solver.support_ratio < 3.0)
     throw SceneError(
         "solver.support_ratio",
         format_number(s.solver.support_ratio) +
@@ -225,7 +254,8 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   for (const auto& [name, m] : materials.items()) {
     Material mat;
     mat.name = name;
-    mat.kind = m["kind"].get<std::string>();
+    mat.kind =
+        choice_of<MaterialKind>(m["kind"], {MaterialKind::Fluid, MaterialKind::Solid, MaterialKind::Ice});
     mat.density = m["density"].get<double>();
     mat.viscosity = m["viscosity"].get<double>();
     mat.conductivity = m["conductivity"].get<double>();
@@ -255,7 +285,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   }
   s.heat.enabled = doc["heat"]["enabled"].get<bool>();
   s.heat.time_scale = doc["heat"]["time_scale"].get<double>();
-  s.heat.exposed_area = doc["heat"]["exposed_area"].get<std::string>();
+  s.heat.exposed_area = choice_of<ExposedArea>(doc["heat"]["exposed_area"], {ExposedArea::Iwasaki2010});
   s.heat.ambient_temperature = doc["ambient"]["temperature"].get<double>();
   s.heat.ambient_coefficient = doc["ambient"]["heat_transfer_coefficient"].get<double>();
   s.heat.wall_coefficient = domain["wall_heat"]["coefficient"].get<double>();
@@ -268,10 +298,10 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   auto check_start = [&](int material, double T, const std::string& path) {
     const Material& m = s.materials[static_cast<std::size_t>(material)];
     if (m.partner < 0) return;
-    if (m.kind == "ice" && T > m.melting_point)
+    if (m.kind == MaterialKind::Ice && T > m.melting_point)
       throw SceneError(path, format_number(T) + " °C is above the melting point of '" + m.name + "' (" +
                                  format_number(m.melting_point) + " °C)");
-    if (m.kind == "fluid" && T < m.melting_point)
+    if (m.kind == MaterialKind::Fluid && T < m.melting_point)
       throw SceneError(path, format_number(T) + " °C is below the freezing point of '" + m.name + "' (" +
                                  format_number(m.melting_point) + " °C); supercooled fluid is not modelled");
   };
@@ -527,16 +557,18 @@ int wall_layer_count(const Scene& s) {
 
 SolverSettings solver_settings_from_json(const Json& j) {
   SolverSettings s;
-  s.kernel = j["kernel"].get<std::string>();
+  s.kernel =
+      choice_of<KernelFunction>(j["kernel"], {KernelFunction::CubicSpline, KernelFunction::WendlandC2});
   s.support_ratio = j["support_ratio"].get<double>();
-  s.eos = j["eos"].get<std::string>();
+  s.eos = choice_of<Eos>(j["eos"], {Eos::Tait, Eos::Linear});
   s.gamma = j["gamma"].get<double>();
   s.speed_of_sound = j["speed_of_sound"].get<double>();
   s.sound_speed_factor = j["sound_speed_factor"].get<double>();
   s.reference_speed = j["reference_speed"].get<double>();
   s.artificial_viscosity = j["artificial_viscosity"].get<double>();
   s.boundary_viscosity = j["boundary_viscosity"].get<double>();
-  s.boundary_volume = j["boundary_volume"].get<std::string>();
+  s.boundary_volume =
+      choice_of<BoundaryVolume>(j["boundary_volume"], {BoundaryVolume::Lattice, BoundaryVolume::Akinci2012});
   s.cfl = j["cfl"].get<double>();
   s.viscous_number = j["viscous_number"].get<double>();
   s.force_number = j["force_number"].get<double>();

@@ -22,9 +22,22 @@ struct Box {
   }
 };
 
+// Choices of the scene file as enums at the host boundary; the scene loader maps the file's spellings
+// (name() gives them back for messages and kernel build options).
+enum class MaterialKind { Fluid, Solid, Ice };
+enum class KernelFunction { CubicSpline, WendlandC2 };
+enum class Eos { Tait, Linear };
+enum class BoundaryVolume { Lattice, Akinci2012 };
+enum class ExposedArea { Iwasaki2010 };
+const char* name(MaterialKind k);    // "fluid", "solid", "ice"
+const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
+const char* name(Eos e);             // "tait", "linear"
+const char* name(BoundaryVolume b);  // "lattice", "akinci"
+const char* name(ExposedArea a);     // "iwasaki2010" (also the heat pass's function suffix)
+
 struct Material {
   std::string name;
-  std::string kind;            // "fluid", "solid" or "ice"
+  MaterialKind kind = MaterialKind::Fluid;
   double density = 1000.0;     // rest density rho0 [kg/m^3]
   double viscosity = 0.0;      // dynamic viscosity mu [Pa s] (fluids)
   double conductivity = 0.0;   // k [W/m/K]
@@ -90,7 +103,7 @@ struct Dryer {
 struct HeatSettings {
   bool enabled = true;
   double time_scale = 1.0;  // heat runs this much faster than the flow
-  std::string exposed_area = "iwasaki2010";
+  ExposedArea exposed_area = ExposedArea::Iwasaki2010;
   double ambient_temperature = 20.0;  // [°C]
   double ambient_coefficient = 10.0;  // h [W/m^2/K]
   double wall_coefficient = 0.0;      // U through the tank walls [W/m^2/K]
@@ -98,24 +111,25 @@ struct HeatSettings {
 };
 
 struct SolverSettings {
-  std::string kernel = "cubic_spline";      // "cubic_spline" | "wendland_c2"
-  double support_ratio = 2.0;               // kernel support radius / particle spacing
-  std::string eos = "tait";                 // "tait" | "linear"
-  double gamma = 7.0;                       // Tait exponent
-  double speed_of_sound = 0.0;              // [m/s]; 0 = sound_speed_factor * reference_speed
-  double sound_speed_factor = 10.0;         // c = factor * v_ref keeps density error near 1/factor^2
-  double reference_speed = 0.0;             // [m/s]; 0 = sqrt(2 g H) from the tallest fluid block
-  double artificial_viscosity = 0.02;       // Monaghan alpha
-  double boundary_viscosity = 0.0;          // alpha against static solids (0 = free slip)
-  std::string boundary_volume = "lattice";  // "lattice": dx^3; "akinci": Akinci 2012 eq. 4, 1 / sum_k W_bk
-  double cfl = 0.4;                         // dt <= cfl * h / (c + v_max)
-  double viscous_number = 0.125;            // dt <= viscous_number * h^2 / nu
-  double force_number = 0.25;               // dt <= force_number * sqrt(h / a_max)
-  double max_dt = 1e-3;                     // [s] user cap
-  double min_dt = 1e-8;                     // [s] below this the run stops as blown up
-  double max_speed = 0.0;                   // [m/s]; 0 = 5 * c; faster particles stop the run as blown up
-  double output_interval = 0.01;            // [s] metrics / export cadence in sim time
-  bool flow = true;                         // false: particles stay put, only heat flows
+  KernelFunction kernel = KernelFunction::CubicSpline;
+  double support_ratio = 2.0;  // kernel support radius / particle spacing
+  Eos eos = Eos::Tait;
+  double gamma = 7.0;                  // Tait exponent
+  double speed_of_sound = 0.0;         // [m/s]; 0 = sound_speed_factor * reference_speed
+  double sound_speed_factor = 10.0;    // c = factor * v_ref keeps density error near 1/factor^2
+  double reference_speed = 0.0;        // [m/s]; 0 = sqrt(2 g H) from the tallest fluid block
+  double artificial_viscosity = 0.02;  // Monaghan alpha
+  double boundary_viscosity = 0.0;     // alpha against static solids (0 = free slip)
+  // Lattice: dx^3; Akinci2012: Akinci 2012 eq. 4, 1 / sum_k W_bk.
+  BoundaryVolume boundary_volume = BoundaryVolume::Lattice;
+  double cfl = 0.4;               // dt <= cfl * h / (c + v_max)
+  double viscous_number = 0.125;  // dt <= viscous_number * h^2 / nu
+  double force_number = 0.25;     // dt <= force_number * sqrt(h / a_max)
+  double max_dt = 1e-3;           // [s] user cap
+  double min_dt = 1e-8;           // [s] below this the run stops as blown up
+  double max_speed = 0.0;         // [m/s]; 0 = 5 * c; faster particles stop the run as blown up
+  double output_interval = 0.01;  // [s] metrics / export cadence in sim time
+  bool flow = true;               // false: particles stay put, only heat flows
   std::array<bool, 3> periodic = {false, false, false};  // axes the domain wraps around (flow = false)
   double diffusion_number = 0.1;  // dt <= diffusion_number * h^2 / (time_scale * alpha_max)
 };

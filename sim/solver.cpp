@@ -60,7 +60,7 @@ RigidIce::Settings rigid_settings(const Scene& scene, const SolverConstants& k) 
   const double dx = scene.spacing;
   double rho_ice = k.rest_density;
   for (const Material& m : scene.materials)
-    if (m.kind == "ice") rho_ice = m.density;
+    if (m.kind == MaterialKind::Ice) rho_ice = m.density;
   r.contact.stiffness = double(k.rest_density) * k.sound_speed * k.sound_speed * dx;
   r.contact.damping = 2.0 * 0.5 * std::sqrt(r.contact.stiffness * rho_ice * dx * dx * dx);
   r.contact.friction = 0.1;
@@ -89,7 +89,8 @@ SolverConstants derive_constants(const Scene& scene) {
   auto consider = [&](int m) {
     if (m < 0) return;
     const Material& mat = scene.materials[static_cast<std::size_t>(m)];
-    if (mat.kind == "fluid") nu = std::max(nu, double(static_cast<float>(mat.viscosity / mat.density)));
+    if (mat.kind == MaterialKind::Fluid)
+      nu = std::max(nu, double(static_cast<float>(mat.viscosity / mat.density)));
   };
   for (const auto& f : scene.fluids) consider(f.material);
   for (const auto& c : scene.ice) consider(scene.materials[static_cast<std::size_t>(c.material)].partner);
@@ -115,7 +116,7 @@ SolverConstants derive_constants(const Scene& scene) {
   }
   k.sound_speed = static_cast<float>(s.speed_of_sound > 0 ? s.speed_of_sound : s.sound_speed_factor * v_ref);
   const double c2 = double(k.sound_speed) * k.sound_speed;
-  k.stiffness = static_cast<float>(s.eos == "tait" ? k.rest_density * c2 / s.gamma : k.rest_density * c2);
+  k.stiffness = static_cast<float>(s.eos == Eos::Tait ? k.rest_density * c2 / s.gamma : k.rest_density * c2);
   k.max_speed = static_cast<float>(s.max_speed > 0 ? s.max_speed : 5.0 * k.sound_speed);
   const float h = k.smoothing;
   k.visc_fluid =
@@ -134,7 +135,7 @@ SolverConstants derive_constants(const Scene& scene) {
   k.exposed_capacity = inf;
   k.wall_dt = inf;
   for (const Material& m : scene.materials) {
-    if (m.kind != "solid")
+    if (m.kind != MaterialKind::Solid)
       k.exposed_capacity = std::min(k.exposed_capacity, m.density * m.specific_heat * dx / 6.0);
     if (m.wall_heat) {
       k.wall_dt = std::min(k.wall_dt, 0.5 * m.density * m.specific_heat * dx * wall_layer_count(scene) /
@@ -181,11 +182,11 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
 
   // Only the kernel and EOS this scene uses are compiled in.
   std::ostringstream opts;
-  const bool wendland = scene.solver.kernel == "wendland_c2";
+  const bool wendland = scene.solver.kernel == KernelFunction::WendlandC2;
   opts << "-DKERNEL_W=" << (wendland ? "wendland_c2_w" : "cubic_spline_w")
        << " -DKERNEL_GRAD=" << (wendland ? "wendland_c2_grad_factor" : "cubic_spline_grad_factor");
-  if (scene.solver.eos == "tait") opts << " -DTHAW_EOS_TAIT";
-  if (scene.solver.eos == "tait" && scene.solver.gamma == 7.0) opts << " -DTHAW_GAMMA_7";
+  if (scene.solver.eos == Eos::Tait) opts << " -DTHAW_EOS_TAIT";
+  if (scene.solver.eos == Eos::Tait && scene.solver.gamma == 7.0) opts << " -DTHAW_GAMMA_7";
   if (wendland) opts << " -DTHAW_WENDLAND";
   // Flush subnormal floats: viscosity spreads velocities of 1e-30 m/s and less through a resting
   // lattice, and arithmetic on subnormals made the forces pass 2-4x slower for tens of steps after a
@@ -253,7 +254,7 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
       throw Error("state: rigid ice bodies without each particle's body and body_offset");
     rigid_->restore({st.rigid_bodies, st.rigid_labelling});
   }
-  if (psi_unknown && scene.solver.boundary_volume == "akinci") compute_boundary_psi();
+  if (psi_unknown && scene.solver.boundary_volume == BoundaryVolume::Akinci2012) compute_boundary_psi();
   if (!st.energy_budget.empty()) {
     budget_ = EnergyBudget::from_vector(st.energy_budget);
   } else {

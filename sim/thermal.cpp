@@ -23,7 +23,7 @@ Law law_of(const Scene& scene, int material) {
   Law law{m.specific_heat, m.specific_heat};
   if (m.partner >= 0) {
     const Material& other = scene.materials[static_cast<std::size_t>(m.partner)];
-    law.ice = m.kind == "ice";
+    law.ice = m.kind == MaterialKind::Ice;
     law.c_solid = law.ice ? m.specific_heat : other.specific_heat;
     law.c_liquid = law.ice ? other.specific_heat : m.specific_heat;
     law.latent = m.latent_heat;
@@ -35,7 +35,7 @@ Law law_of(const Scene& scene, int material) {
 }  // namespace
 
 double mass_scale(const Material& m, double rest_density) {
-  return m.kind == "fluid" ? 1.0 : m.density / rest_density;
+  return m.kind == MaterialKind::Fluid ? 1.0 : m.density / rest_density;
 }
 
 std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density) {
@@ -58,7 +58,7 @@ std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double r
       t.flags |= law.ice ? THAW_MAT_MELTS : THAW_MAT_FREEZES;
     }
     t.thermal_mass_scale = static_cast<float>(mass_scale(m, rest_density));
-    if (m.kind != "solid") t.flags |= THAW_MAT_AIR_EXCHANGE;
+    if (m.kind != MaterialKind::Solid) t.flags |= THAW_MAT_AIR_EXCHANGE;
     if (m.held) {
       t.flags |= THAW_MAT_HELD;
       t.held_enthalpy = static_cast<float>(enthalpy_at(scene, static_cast<int>(i), m.held_temperature));

@@ -26,7 +26,8 @@ double HydrostaticProfile::height_of(double z_nominal) const {
 
 HydrostaticProfile hydrostatic_profile(const Scene& scene, double H) {
   const SolverConstants k = derive_constants(scene);
-  return {k.rest_density, -scene.gravity.z(), H, k.stiffness, scene.solver.gamma, scene.solver.eos == "tait"};
+  return {k.rest_density, -scene.gravity.z(), H,
+          k.stiffness,    scene.solver.gamma, scene.solver.eos == Eos::Tait};
 }
 
 void compress_to_hydrostatic(HostParticles& p, const HydrostaticProfile& profile) {

@@ -114,7 +114,7 @@ TEST(Scene, DefaultSceneResolvesByName) {
 
 TEST(Scene, DocumentedExampleLoads) {
   const Scene s = scene_from_json(Json::parse(scene_example_json()));
-  EXPECT_EQ(s.solver.kernel, "wendland_c2");
+  EXPECT_EQ(s.solver.kernel, KernelFunction::WendlandC2);
 }
 
 TEST(Scene, DocsAreGeneratedFromTheSchema) {
@@ -138,9 +138,9 @@ TEST(Scene, DocsAreGeneratedFromTheSchema) {
 TEST(Scene, DefaultsAreFilledIn) {
   const Scene s = scene_from_json(base_scene());
   EXPECT_EQ(s.solver.cfl, 0.4);
-  EXPECT_EQ(s.solver.kernel, "cubic_spline");
+  EXPECT_EQ(s.solver.kernel, KernelFunction::CubicSpline);
   EXPECT_EQ(s.wall_layers, 0);
-  EXPECT_EQ(s.solver.boundary_volume, "lattice");
+  EXPECT_EQ(s.solver.boundary_volume, BoundaryVolume::Lattice);
   EXPECT_EQ(s.gravity, Eigen::Vector3d(0, 0, -9.81));
   EXPECT_EQ(s.wall_layers, 0);
   EXPECT_EQ(s.fluids[0].velocity, Eigen::Vector3d(0, 0, 0));
@@ -153,7 +153,7 @@ TEST(Scene, ConvertsEveryField) {
   const Scene s = scene_from_json(base_scene());
   ASSERT_EQ(s.materials.size(), 2u);
   EXPECT_EQ(s.materials[0].name, "water");  // document order
-  EXPECT_EQ(s.materials[1].kind, "solid");
+  EXPECT_EQ(s.materials[1].kind, MaterialKind::Solid);
   EXPECT_EQ(s.materials[1].density, 2500.0);
   EXPECT_EQ(s.wall_material, 1);
   EXPECT_EQ(s.walls, (std::vector<std::string>{"-x", "+x", "-z"}));
@@ -205,7 +205,7 @@ TEST(SceneOverride, SetsNumbersArraysAndBareStrings) {
   EXPECT_EQ(s.fluids[0].box.max, Eigen::Vector3d(0.05, 0.05, 0.05));
   EXPECT_EQ(s.fluids[1].velocity, Eigen::Vector3d(0, 0, -1));
   EXPECT_EQ(s.gravity.z(), -1.62);
-  EXPECT_EQ(s.solver.kernel, "wendland_c2");
+  EXPECT_EQ(s.solver.kernel, KernelFunction::WendlandC2);
 }
 
 TEST(SceneOverride, CreatesMissingSectionsThenValidates) {
@@ -778,7 +778,7 @@ TEST(Schema, ACaseDeclaresItsOwnParametersAndEmbedsTheSolver) {
   validate(doc, params);
   EXPECT_EQ(doc["length"], 1.0);
   EXPECT_EQ(solver_settings_from_json(doc["solver"]).cfl, 0.2);
-  EXPECT_EQ(solver_settings_from_json(doc["solver"]).eos, "tait");
+  EXPECT_EQ(solver_settings_from_json(doc["solver"]).eos, Eos::Tait);
 
   Json bad = {{"samples", 1}};
   try {
