@@ -163,24 +163,10 @@ EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
   return b;
 }
 
-Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
-    : cl_(cl), scene_(scene), k_(derive_constants(scene)), store_(cl) {
-  const HostParticles& p = st.particles;
-  n_ = p.size();
-  time_ = st.time;
-  dt_ = st.dt;
-  steps_ = st.step;
-  clamped_base_ = st.clamped;
+namespace {
 
-  // Grid bounds: the domain and every particle (walls lie outside the domain), plus one cell.
-  Eigen::Vector3f lo = scene.domain.min.cast<float>(), hi = scene.domain.max.cast<float>();
-  for (const auto& x : p.position) {
-    lo = lo.cwiseMin(Eigen::Vector3f(x[0], x[1], x[2]));
-    hi = hi.cwiseMax(Eigen::Vector3f(x[0], x[1], x[2]));
-  }
-  layout_ = layout_for(n_);
-
-  // Only the kernel and EOS this scene uses are compiled in.
+// Only the kernel and EOS this scene uses are compiled in.
+std::string program_options(const Scene& scene) {
   std::ostringstream opts;
   const bool wendland = scene.solver.kernel == KernelFunction::WendlandC2;
   opts << "-DKERNEL_W=" << (wendland ? "wendland_c2_w" : "cubic_spline_w")
@@ -193,74 +179,94 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
   // start (measured: docs/BENCHMARKS.md). Nothing physical lives below 1e-38.
   opts << " -cl-denorms-are-zero";
   opts << " -DTHAW_REACH=" << kGridReach << " -DTHAW_VW=" << kLanes;
-  grid_ = std::make_unique<NeighbourGrid>(cl, scene_, k_.support, kGridReach, opts.str(), layout_, lo, hi);
-  const auto boundary = cl.build(with_prelude({"boundary.cl"}), opts.str());
-  k_psi_ = cl::Kernel(boundary, "boundary_psi");
-  k_set_mass_ = cl::Kernel(boundary, "set_mass");
+  return opts.str();
+}
 
-  auto& ctx = cl.context();
-  const std::size_t n = std::max<std::size_t>(n_, 1);
-  auto buf = [&](std::size_t bytes) {
-    return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
-  };
-  // Per-particle fields: the core ones, then each stage's (heat's enthalpy, rigid ice's bodies).
-  for (const FieldSpec& f : core_fields()) {
-    const ParticleStore::Field h = store_.add(f);
-    if (f.name == "position") f_.position = h;
-    if (f.name == "velocity") f_.velocity = h;
-    if (f.name == "density") f_.density = h;
-    if (f.name == "phase") f_.phase = h;
-    if (f.name == "material") f_.material = h;
-    if (f.name == "id") f_.id = h;
+// The domain and every particle (walls lie outside the domain).
+std::pair<Eigen::Vector3f, Eigen::Vector3f> particle_bounds(const Scene& scene, const HostParticles& p) {
+  Eigen::Vector3f lo = scene.domain.min.cast<float>(), hi = scene.domain.max.cast<float>();
+  for (const auto& x : p.position) {
+    lo = lo.cwiseMin(Eigen::Vector3f(x[0], x[1], x[2]));
+    hi = hi.cwiseMax(Eigen::Vector3f(x[0], x[1], x[2]));
   }
-  const HeatPlan plan = plan_heat(scene, p);
-  heat_reason_ = plan.reason;
-  if (plan.build)
-    heat_ = std::make_unique<HeatStage>(cl, store_, f_, scene_, plan, k_, opts.str(), layout_, lo, hi);
-  if (scene.solver.flow)
-    fluid_ = std::make_unique<FluidStage>(cl, store_, f_, scene_, k_, opts.str(), layout_);
-  scratch_ = buf(n * 4);
-  clamped_ = buf(4);
-  table_ = material_thermal_table(scene, k_.rest_density);
+  return {lo, hi};
+}
 
-  // Boundary particles sampled by sample_scene() carry no mass yet: their Psi = rho0 V_b comes from
-  // the solver's rest density. Walls here sit on the fluid lattice and fill the kernel support, so the
-  // lattice cell dx^3 is their exact volume; Akinci's 1 / sum_k W_bk suits single-layer or irregular
-  // samplings but overestimates the fluid-facing layer of a lattice wall (by 18 % at H = 2 dx, which
-  // raised the wall-adjacent density by 2.6 %: measured with configs/hydrostatic-tank.json).
-  HostParticles init = p;
-  bool psi_unknown = false;
-  const float lattice_psi = static_cast<float>(k_.rest_density * std::pow(scene.spacing, 3));
-  for (std::size_t i = 0; i < n_; ++i)
-    if (init.phase[i] == static_cast<std::uint8_t>(Phase::Solid) && init.position[i][3] == 0.0f) {
-      psi_unknown = true;
-      init.position[i][3] = lattice_psi;
+// Boundary particles sampled by sample_scene() carry no mass yet: their Psi = rho0 V_b comes from the
+// solver's rest density. Walls here sit on the fluid lattice and fill the kernel support, so the lattice
+// cell dx^3 is their exact volume; Akinci's 1 / sum_k W_bk suits single-layer or irregular samplings but
+// overestimates the fluid-facing layer of a lattice wall (by 18 % at H = 2 dx, which raised the
+// wall-adjacent density by 2.6 %: measured with configs/hydrostatic-tank.json). Returns whether any
+// boundary mass was missing.
+bool give_boundaries_lattice_mass(HostParticles& p, const Scene& scene, float rest_density) {
+  bool missing = false;
+  const float lattice_psi = static_cast<float>(rest_density * std::pow(scene.spacing, 3));
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.phase[i] == static_cast<std::uint8_t>(Phase::Solid) && p.position[i][3] == 0.0f) {
+      missing = true;
+      p.position[i][3] = lattice_psi;
     }
+  return missing;
+}
+
+// Rigid ice for scenes with free ice and flow; null otherwise.
+std::unique_ptr<RigidIce> make_rigid_ice(ClRuntime& cl, ParticleStore& store, const std::string& opts,
+                                         const Scene& scene, const SolverConstants& k,
+                                         const HostParticles& p) {
   const bool free_ice = std::any_of(scene.ice.begin(), scene.ice.end(),
                                     [](const IceBlock& b) { return b.motion == IceBlock::Motion::Free; });
-  if (free_ice && scene.solver.flow) {
-    std::vector<std::uint8_t> anchored_by_id(n_, 0);
-    for (std::size_t i = 0; i < n_ && i < p.anchored.size(); ++i)
-      if (p.id[i] < n_) anchored_by_id[p.id[i]] = p.anchored[i];
-    rigid_ = std::make_unique<RigidIce>(cl, store_, opts.str(), n_, rigid_settings(scene, k_),
-                                        std::move(anchored_by_id), rigid_mass_scales(scene, k_.rest_density));
-  }
-  // Every stage has declared its fields: allocate them and upload the state (a field the state lacks
-  // starts at its declared fill).
+  if (!free_ice || !scene.solver.flow) return nullptr;
+  const std::size_t n = p.size();
+  std::vector<std::uint8_t> anchored_by_id(n, 0);
+  for (std::size_t i = 0; i < n && i < p.anchored.size(); ++i)
+    if (p.id[i] < n) anchored_by_id[p.id[i]] = p.anchored[i];
+  return std::make_unique<RigidIce>(cl, store, opts, n, rigid_settings(scene, k), std::move(anchored_by_id),
+                                    rigid_mass_scales(scene, k.rest_density));
+}
+
+}  // namespace
+
+Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
+    : cl_(cl), scene_(scene), k_(derive_constants(scene)), store_(cl) {
+  const HostParticles& p = st.particles;
+  n_ = p.size();
+  time_ = st.time;
+  dt_ = st.dt;
+  steps_ = st.step;
+  clamped_base_ = st.clamped;
+  layout_ = layout_for(n_);
+  const auto [lo, hi] = particle_bounds(scene, p);
+  const std::string opts = program_options(scene);
+  const HeatPlan plan = plan_heat(scene, p);
+  heat_reason_ = plan.reason;
+
+  // The stages this scene needs, each declaring its fields; then the fields are allocated and filled.
+  f_ = add_core_fields(store_);
+  grid_ = std::make_unique<NeighbourGrid>(cl, scene_, k_.support, kGridReach, opts, layout_, lo, hi);
+  if (scene.solver.flow) fluid_ = std::make_unique<FluidStage>(cl, store_, f_, scene_, k_, opts, layout_);
+  rigid_ = make_rigid_ice(cl, store_, opts, scene, k_, p);
+  if (plan.build)
+    heat_ = std::make_unique<HeatStage>(cl, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
   store_.allocate(n_);
+
+  const auto boundary = cl.build(with_prelude({"boundary.cl"}), opts);
+  k_psi_ = cl::Kernel(boundary, "boundary_psi");
+  k_set_mass_ = cl::Kernel(boundary, "set_mass");
+  scratch_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(n_, 1) * 4);
+  clamped_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, 4);
+  table_ = material_thermal_table(scene, k_.rest_density);
+
+  HostParticles init = p;
+  const bool psi_missing = give_boundaries_lattice_mass(init, scene, k_.rest_density);
   upload(init);
+  if (psi_missing && scene.solver.boundary_volume == BoundaryVolume::Akinci2012) compute_boundary_psi();
   if (rigid_ && !st.rigid_bodies.empty()) {
     if (!p.column("body") || !p.column("body_offset"))
       throw Error("state: rigid ice bodies without each particle's body and body_offset");
     rigid_->restore({st.rigid_bodies, st.rigid_labelling});
   }
-  if (psi_unknown && scene.solver.boundary_volume == BoundaryVolume::Akinci2012) compute_boundary_psi();
-  if (!st.energy_budget.empty()) {
-    budget_ = EnergyBudget::from_vector(st.energy_budget);
-  } else {
-    budget_ = EnergyBudget{};
-    budget_.initial = total_enthalpy();
-  }
+  budget_ = st.energy_budget.empty() ? EnergyBudget{} : EnergyBudget::from_vector(st.energy_budget);
+  if (st.energy_budget.empty()) budget_.initial = total_enthalpy();
 }
 
 Solver::~Solver() = default;

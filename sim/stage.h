@@ -48,4 +48,19 @@ struct CoreFields {
   ParticleStore::Field position = 0, velocity = 0, density = 0, phase = 0, material = 0, id = 0;
 };
 
+// Declares the core fields in `store` and returns their handles.
+inline CoreFields add_core_fields(ParticleStore& store) {
+  CoreFields f;
+  for (const FieldSpec& spec : core_fields()) {
+    const ParticleStore::Field h = store.add(spec);
+    if (spec.name == "position") f.position = h;
+    if (spec.name == "velocity") f.velocity = h;
+    if (spec.name == "density") f.density = h;
+    if (spec.name == "phase") f.phase = h;
+    if (spec.name == "material") f.material = h;
+    if (spec.name == "id") f.id = h;
+  }
+  return f;
+}
+
 }  // namespace thaw
