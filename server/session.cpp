@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <future>
+#include <regex>
 
 #include "server/thread_priority.h"
 #include "sim/error.h"
@@ -28,30 +29,6 @@ struct Overloaded : F... {
 };
 template <class... F>
 Overloaded(F...) -> Overloaded<F...>;
-
-Json vec_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
-
-Json dryer_json(const Dryer& d) {
-  return {{"on", d.on},
-          {"position", vec_json(d.position)},
-          {"direction", vec_json(d.direction)},
-          {"half_angle", d.half_angle},
-          {"reach", d.reach},
-          {"temperature", d.temperature},
-          {"speed", d.speed},
-          {"nozzle_diameter", d.nozzle_diameter}};
-}
-
-Json lamp_json(const Lamp& l) {
-  return {{"on", l.on},
-          {"centre", vec_json(l.centre)},
-          {"normal", vec_json(l.normal)},
-          {"width", l.width},
-          {"height", l.height},
-          {"temperature", l.temperature},
-          {"emissivity", l.emissivity},
-          {"photons", l.photons}};
-}
 
 // State names become file names in the state folder: nothing that could leave it (docs/ARCHITECTURE.md: the
 // protocol checks this too; the session does not rely on its caller for what touches the disk).
@@ -447,7 +424,7 @@ Session::Outcome Session::set_dryer(int index, const Dryer& d) {
   }
   const Dryer& now = solver_->dryers()[std::size_t(index)];
   scene_.dryers[std::size_t(index)] = now;
-  const Json fields = dryer_json(now);
+  const Json fields = to_json(now);
   Json& source = scene_.source["dryers"][std::size_t(index)];
   for (const auto& [key, value] : fields.items()) source[key] = value;
   {
@@ -503,15 +480,19 @@ Session::Outcome Session::apply(const protocol::LampSet& c) {
   if (c.normal) l.normal = *c.normal;
   if (c.temperature) l.temperature = *c.temperature;
   if (c.emissivity) l.emissivity = *c.emissivity;
+  return set_lamp(c.lamp, l);
+}
+
+Session::Outcome Session::set_lamp(int index, const Lamp& l) {
   try {
-    solver_->set_lamp(std::size_t(c.lamp), l);
+    solver_->set_lamp(std::size_t(index), l);
   } catch (const Error& e) {
     return {ErrorCode::BadField, e.what(), {}};
   }
-  const Lamp& now = solver_->lamps()[std::size_t(c.lamp)];
-  scene_.lamps[std::size_t(c.lamp)] = now;
-  const Json fields = lamp_json(now);
-  Json& source = scene_.source["lamps"][std::size_t(c.lamp)];
+  const Lamp& now = solver_->lamps()[std::size_t(index)];
+  scene_.lamps[std::size_t(index)] = now;
+  const Json fields = to_json(now);
+  Json& source = scene_.source["lamps"][std::size_t(index)];
   for (const auto& [key, value] : fields.items()) source[key] = value;
   {
     std::lock_guard lock(publish_mutex_);
@@ -519,7 +500,7 @@ Session::Outcome Session::apply(const protocol::LampSet& c) {
   }
   dirty_ = true;
   Json result = fields;
-  result["lamp"] = c.lamp;
+  result["lamp"] = index;
   return {std::nullopt, "", result};
 }
 
@@ -565,9 +546,22 @@ Session::Outcome Session::apply(const protocol::ParamSet& c) {
   } catch (const Error& e) {
     return {ErrorCode::BadField, e.what(), {}};
   }
-  // The new scene starts from the particles as they are, so the change takes effect mid-run.
+  // A field the schema marks live in place (a dryer's or a lamp's) goes the way dryer.set and lamp.set
+  // go: into the running solver between two steps. Any other change rebuilds the solver from the
+  // particles as they are, so it takes effect mid-run.
+  if (field->in_place) {
+    static const std::regex element(R"(^(dryers|lamps)(?:\[(\d+)\]|\.(\d+))\.)");
+    std::smatch m;
+    if (std::regex_search(c.path, m, element)) {
+      const std::size_t index = std::stoul(m[2].matched ? m[2].str() : m[3].str());
+      const Outcome done = m[1] == "dryers" ? set_dryer(int(index), scene.dryers.at(index))
+                                            : set_lamp(int(index), scene.lamps.at(index));
+      if (done.code) return done;
+      return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}, {"applied", "in place"}}};
+    }
+  }
   rebuild(std::move(scene), solver_->state(), false);
-  return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}}};
+  return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}, {"applied", "rebuild"}}};
 }
 
 Session::Outcome Session::apply(const protocol::StateSave& c) {

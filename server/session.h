@@ -1,8 +1,8 @@
 #pragma once
-// The simulation thread of `thaw serve` (docs/ARCHITECTURE.md, Server): it owns the Solver, applies the commands the
-// network loop queues between two steps, and publishes what the other threads read — a render snapshot
-// and a stats event — by swapping shared pointers under a mutex. It never waits on a consumer: a reader
-// takes the newest value when it likes, and a slow one simply misses intermediate ones.
+// The simulation thread of `thaw serve` (docs/ARCHITECTURE.md, Server): it owns the Solver, applies the
+// commands the network loop queues between two steps, and publishes what the other threads read — a render
+// snapshot and a stats event — by swapping shared pointers under a mutex. It never waits on a consumer: a
+// reader takes the newest value when it likes, and a slow one simply misses intermediate ones.
 //
 // Threads: the constructor and start() run on the owner's thread; everything that touches the Solver
 // (stepping, commands, snapshots, state files) runs on the session's own thread once started. The
@@ -134,7 +134,10 @@ class Session {
   Outcome apply(const protocol::StateSave& c);
   Outcome apply(const protocol::StateLoad& c);
   Outcome aim(const Aim& a);
+  // Into the running solver, the scene and its published copy (dryer.set, lamp.set, dryer.aim and
+  // param.set of a field the schema marks live in place).
   Outcome set_dryer(int index, const Dryer& d);
+  Outcome set_lamp(int index, const Lamp& l);
 
   void step_once();
   void rebuild(Scene scene, const SimState& state, bool fresh_start);

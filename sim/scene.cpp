@@ -405,36 +405,10 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   if (s.materials.size() > 255)
     throw SceneError("solids", "too many materials (held solids count as their own): at most 255");
 
-  for (std::size_t i = 0; i < doc["lamps"].size(); ++i) {
-    const Json& j = doc["lamps"][i];
-    const std::string path = join_path("lamps", i);
-    Lamp lamp;
-    lamp.on = j["on"].get<bool>();
-    lamp.centre = vec(j["centre"]);
-    lamp.normal = vec(j["normal"]);
-    lamp.normal = unit_direction(lamp.normal, path + ".normal");
-    lamp.width = j["width"].get<double>();
-    lamp.height = j["height"].get<double>();
-    lamp.temperature = j["temperature"].get<double>();
-    lamp.emissivity = j["emissivity"].get<double>();
-    lamp.photons = j["photons"].get<int>();
-    s.lamps.push_back(lamp);
-  }
-  for (std::size_t i = 0; i < doc["dryers"].size(); ++i) {
-    const Json& j = doc["dryers"][i];
-    const std::string path = join_path("dryers", i);
-    Dryer d;
-    d.on = j["on"].get<bool>();
-    d.position = vec(j["position"]);
-    d.direction = vec(j["direction"]);
-    d.direction = unit_direction(d.direction, path + ".direction");
-    d.half_angle = j["half_angle"].get<double>();
-    d.reach = j["reach"].get<double>();
-    d.temperature = j["temperature"].get<double>();
-    d.speed = j["speed"].get<double>();
-    d.nozzle_diameter = j["nozzle_diameter"].get<double>();
-    s.dryers.push_back(d);
-  }
+  for (std::size_t i = 0; i < doc["lamps"].size(); ++i)
+    s.lamps.push_back(lamp_from_json(doc["lamps"][i], join_path("lamps", i)));
+  for (std::size_t i = 0; i < doc["dryers"].size(); ++i)
+    s.dryers.push_back(dryer_from_json(doc["dryers"][i], join_path("dryers", i)));
 
   for (int a = 0; a < 3; ++a) {
     if (!s.solver.periodic[static_cast<std::size_t>(a)]) continue;
@@ -502,6 +476,56 @@ std::string parse_reason(const std::string& what) {
 }
 
 }  // namespace
+
+Json to_json(const Dryer& d) {
+  const auto v = [](const Eigen::Vector3d& x) { return Json::array({x.x(), x.y(), x.z()}); };
+  return {{"on", d.on},
+          {"position", v(d.position)},
+          {"direction", v(d.direction)},
+          {"half_angle", d.half_angle},
+          {"reach", d.reach},
+          {"temperature", d.temperature},
+          {"speed", d.speed},
+          {"nozzle_diameter", d.nozzle_diameter}};
+}
+
+Json to_json(const Lamp& l) {
+  const auto v = [](const Eigen::Vector3d& x) { return Json::array({x.x(), x.y(), x.z()}); };
+  return {{"on", l.on},
+          {"centre", v(l.centre)},
+          {"normal", v(l.normal)},
+          {"width", l.width},
+          {"height", l.height},
+          {"temperature", l.temperature},
+          {"emissivity", l.emissivity},
+          {"photons", l.photons}};
+}
+
+Dryer dryer_from_json(const Json& j, const std::string& path) {
+  Dryer d;
+  d.on = j["on"].get<bool>();
+  d.position = vec(j["position"]);
+  d.direction = unit_direction(vec(j["direction"]), path + ".direction");
+  d.half_angle = j["half_angle"].get<double>();
+  d.reach = j["reach"].get<double>();
+  d.temperature = j["temperature"].get<double>();
+  d.speed = j["speed"].get<double>();
+  d.nozzle_diameter = j["nozzle_diameter"].get<double>();
+  return d;
+}
+
+Lamp lamp_from_json(const Json& j, const std::string& path) {
+  Lamp l;
+  l.on = j["on"].get<bool>();
+  l.centre = vec(j["centre"]);
+  l.normal = unit_direction(vec(j["normal"]), path + ".normal");
+  l.width = j["width"].get<double>();
+  l.height = j["height"].get<double>();
+  l.temperature = j["temperature"].get<double>();
+  l.emissivity = j["emissivity"].get<double>();
+  l.photons = j["photons"].get<int>();
+  return l;
+}
 
 Eigen::Vector3d unit_direction(const Eigen::Vector3d& v, const std::string& path) {
   const double squared = v.squaredNorm();

@@ -154,6 +154,14 @@ struct Scene {
   Json source;  // the validated document with every default filled in
 };
 
+// One converter each way per live struct, shared by the scene loader, the solver's live setters and the
+// service's replies. *_from_json takes an element the schema has validated (validate() fills the
+// defaults) and refuses a zero or overflowing direction, naming `path` ("dryers[0]").
+Json to_json(const Dryer& d);
+Json to_json(const Lamp& l);
+Dryer dryer_from_json(const Json& j, const std::string& path);
+Lamp lamp_from_json(const Json& j, const std::string& path);
+
 // `v` scaled to unit length; `path` names it in the SceneError when it is not a vector of moderate size:
 // zero, or so long or so short that its squared length overflows or underflows a double. The protocol
 // refuses the same vectors: [1e308, 1e308, 1e308] normalised to zeros, and the dryer delivered 0 J.

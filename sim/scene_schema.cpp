@@ -366,10 +366,9 @@ const Field& scene_schema() {
           array_of(
               "lamps",
               {
-                  flag("on", "Emitting").def(true).client_settable(),
-                  vec3("centre", "Centre of the emitting rectangle").in("m").client_settable(),
-                  vec3("normal", "The way the emitting face looks; need not be unit length")
-                      .client_settable(),
+                  flag("on", "Emitting").def(true).live_in_place(),
+                  vec3("centre", "Centre of the emitting rectangle").in("m").live_in_place(),
+                  vec3("normal", "The way the emitting face looks; need not be unit length").live_in_place(),
                   number("width", "Extent of the rectangle across the normal (horizontal where it can be)")
                       .in("m")
                       .above(0)
@@ -382,8 +381,8 @@ const Field& scene_schema() {
                       .in("°C")
                       .above(-273.15)
                       .at_most(3000)
-                      .client_settable(),
-                  number("emissivity", "Emissivity factor").def(0.9).above(0).at_most(1).client_settable(),
+                      .live_in_place(),
+                  number("emissivity", "Emissivity factor").def(0.9).above(0).at_most(1).live_in_place(),
                   integer("photons", "Thermal photons emitted per step")
                       .def(4096)
                       .at_least(1)
@@ -395,33 +394,33 @@ const Field& scene_schema() {
           array_of(
               "dryers",
               {
-                  flag("on", "Blowing").def(true).client_settable(),
-                  vec3("position", "Nozzle position").in("m").client_settable(),
-                  vec3("direction", "Where the air blows; need not be unit length").client_settable(),
+                  flag("on", "Blowing").def(true).live_in_place(),
+                  vec3("position", "Nozzle position").in("m").live_in_place(),
+                  vec3("direction", "Where the air blows; need not be unit length").live_in_place(),
                   number("half_angle", "Half-angle of the cone of warm air")
                       .in("deg")
                       .def(15.0)
                       .above(0)
                       .at_most(60)
-                      .client_settable(),
+                      .live_in_place(),
                   number("reach", "Length of the cone; nothing beyond it feels the dryer")
                       .in("m")
                       .def(0.3)
                       .above(0)
                       .at_most(10)
-                      .client_settable(),
+                      .live_in_place(),
                   number("temperature", "Air temperature at the nozzle")
                       .in("°C")
                       .def(60.0)
                       .above(-100)
                       .at_most(500)
-                      .client_settable(),
+                      .live_in_place(),
                   number("speed", "Air speed at the nozzle")
                       .in("m/s")
                       .def(10.0)
                       .at_least(0)
                       .at_most(100)
-                      .client_settable(),
+                      .live_in_place(),
                   number("nozzle_diameter",
                          "Sets the jet's core length (6 diameters) and the length scale of "
                          "its heat-transfer coefficient")

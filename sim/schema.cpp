@@ -46,6 +46,11 @@ Field& Field::client_settable() {
   settable = true;
   return *this;
 }
+Field& Field::live_in_place() {
+  settable = true;
+  in_place = true;
+  return *this;
+}
 Field& Field::when(std::string sibling, std::string value) {
   when_key = std::move(sibling);
   when_value = std::move(value);
@@ -617,8 +622,11 @@ void render(const std::vector<Field>& fields, const std::string& title, const st
     }
     const std::string range = f.nonempty ? "non-empty" : range_text(f);
     out += "| `" + f.key + "` | " + cell(type_text(f, child)) + " | " + cell(f.unit) + " | " +
-           cell(default_text(f)) + " | " + cell(range) + " | " + (f.settable ? "yes" : "") + " | " +
-           cell(f.doc) + " |\n";
+           cell(default_text(f)) + " | " + cell(range) + " | " +
+           (f.in_place   ? "in place"
+            : f.settable ? "rebuild"
+                         : "") +
+           " | " + cell(f.doc) + " |\n";
     if (!body->fields.empty()) nested.push_back({body, child, f.doc});
   }
   out += "\n";

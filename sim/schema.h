@@ -50,6 +50,7 @@ struct Field {
   std::optional<Bound> min, max;      // numbers and integers
   bool nonempty = false;              // arrays, maps and subsets must have an element
   bool settable = false;              // a connected client may change it while the simulation runs
+  bool in_place = false;              // settable, and applied to the running solver without a rebuild
   std::vector<std::string> choices;   // Choice, Subset
   std::vector<Field> fields;          // Object: its fields; Map and Array: one, the element object
   std::string when_key, when_value;   // present exactly when sibling `when_key` equals `when_value`
@@ -63,7 +64,8 @@ struct Field {
   Field& below(double v);     // < v
   Field& at_most(double v);   // <= v
   Field& non_empty();
-  Field& client_settable();
+  Field& client_settable();  // a change rebuilds the solver from the particles as they are
+  Field& live_in_place();    // settable, and applied between two steps without a rebuild
   Field& when(std::string sibling, std::string value);
 
   // Required: no default, not optional, no `when` (objects: some child is required).

@@ -476,18 +476,9 @@ void Solver::set_dryer(std::size_t index, const Dryer& d) {
     throw Error("dryer " + std::to_string(index) + " does not exist; the scene has " +
                 std::to_string(scene_.dryers.size()));
   const std::string path = "dryers[" + std::to_string(index) + "]";
-  Json j = {{"on", d.on},
-            {"position", {d.position.x(), d.position.y(), d.position.z()}},
-            {"direction", {d.direction.x(), d.direction.y(), d.direction.z()}},
-            {"half_angle", d.half_angle},
-            {"reach", d.reach},
-            {"temperature", d.temperature},
-            {"speed", d.speed},
-            {"nozzle_diameter", d.nozzle_diameter}};
+  Json j = to_json(d);
   validate(j, *find_field(scene_schema(), "dryers[0]"), path);
-  Dryer checked = d;
-  checked.direction = unit_direction(d.direction, path + ".direction");
-  scene_.dryers[index] = checked;
+  scene_.dryers[index] = dryer_from_json(j, path);
   if (heat_) heat_->dryers_changed();
 }
 
@@ -496,18 +487,9 @@ void Solver::set_lamp(std::size_t index, const Lamp& l) {
     throw Error("lamp " + std::to_string(index) + " does not exist; the scene has " +
                 std::to_string(scene_.lamps.size()));
   const std::string path = "lamps[" + std::to_string(index) + "]";
-  Json j = {{"on", l.on},
-            {"centre", {l.centre.x(), l.centre.y(), l.centre.z()}},
-            {"normal", {l.normal.x(), l.normal.y(), l.normal.z()}},
-            {"width", l.width},
-            {"height", l.height},
-            {"temperature", l.temperature},
-            {"emissivity", l.emissivity},
-            {"photons", l.photons}};
+  Json j = to_json(l);
   validate(j, *find_field(scene_schema(), "lamps[0]"), path);
-  Lamp checked = l;
-  checked.normal = unit_direction(l.normal, path + ".normal");
-  scene_.lamps[index] = checked;
+  scene_.lamps[index] = lamp_from_json(j, path);
   if (heat_) heat_->lamps_changed();
 }
 

@@ -325,6 +325,30 @@ TEST_F(SessionTest, ParamSetTakesEffectAndKeepsTheParticles) {
   ASSERT_FALSE(call(*s, protocol::SimStep{2}).code);
 }
 
+// A dryer's and a lamp's fields are live in place (the schema says so): param.set of one takes the same
+// path as dryer.set, into the running solver; other live fields rebuild it from the particles.
+TEST_F(SessionTest, ParamSetOfADryerFieldAppliesInPlaceLikeDryerSet) {
+  auto s = make("default");
+  s->start();
+  wait_for_stats(*s, [](const Json& j) { return j["steps"].get<std::uint64_t>() >= 1; });
+  ASSERT_FALSE(call(*s, protocol::SimPause{}).code);
+  Reply r = call(*s, protocol::ParamSet{"dryers[0].speed", 31.5});
+  ASSERT_TRUE(r.answered);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["applied"], "in place");
+  EXPECT_EQ(s->scene()->dryers.at(0).speed, 31.5);
+  EXPECT_EQ(s->scene()->source["dryers"][0]["speed"], 31.5) << "the scene document follows";
+  r = call(*s, protocol::ParamSet{"dryers.0.direction", Json::array({0, 0, 0})});
+  EXPECT_EQ(r.code, ErrorCode::BadField) << "checked like dryer.set: " << r.message;
+  r = call(*s, protocol::ParamSet{"heat.time_scale", 20});
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["applied"], "rebuild");
+  EXPECT_EQ(s->scene()->dryers.at(0).speed, 31.5) << "a rebuild keeps the in-place change";
+  const Field* speed = find_field(scene_schema(), "dryers[0].speed");
+  ASSERT_TRUE(speed);
+  EXPECT_TRUE(speed->settable && speed->in_place);
+}
+
 TEST_F(SessionTest, BlowUpPausesAndReportsWithoutCrashing) {
   // A block thrown down at 1 m/s under a speed limit of 1.02 m/s: gravity breaks the limit within
   // a few milliseconds of simulated time.
