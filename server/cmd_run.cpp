@@ -212,6 +212,10 @@ int cmd_run(int argc, char** argv) {
         "clamped %llu, kinetic %.4g J\n",
         m.dt, m.max_speed, 100 * m.max_density_error, 100 * m.mean_density_error, m.fluid_mass,
         (unsigned long long)m.clamped, m.kinetic);
+    if (m.outflow.particles)
+      std::printf("outflow: %llu particles, %.9g kg, momentum (%.4g, %.4g, %.4g) kg m/s, enthalpy %.6g J\n",
+                  (unsigned long long)m.outflow.particles, m.outflow.mass, m.outflow.momentum.x(),
+                  m.outflow.momentum.y(), m.outflow.momentum.z(), m.budget.outflow);
     if (m.heat) {
       const EnergyBudget& b = m.budget;
       std::printf(

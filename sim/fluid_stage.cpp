@@ -95,6 +95,7 @@ FluidStage::FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
 
 void FluidStage::density(const NeighbourView& nv) {
   if (layout_.n == 0) return;
+  density_params_.n = static_cast<cl_uint>(layout_.n);
   set_args(k_density_, store_[f_.position], nv.soa, store_[f_.phase], store_[f_.material], flow_,
            nv.cell_start, nv.grid, density_params_, store_[f_.density], state_, derived_);
   launch(cl_.queue(), k_density_, layout_.n);
@@ -102,6 +103,7 @@ void FluidStage::density(const NeighbourView& nv) {
 
 void FluidStage::forces(const NeighbourView& nv) {
   if (layout_.n == 0) return;
+  forces_params_.n = static_cast<cl_uint>(layout_.n);
   set_args(k_forces_, store_[f_.position], store_[f_.velocity], nv.soa, derived_, state_, store_[f_.phase],
            store_[f_.material], flow_, nv.cell_start, nv.grid, forces_params_, accel_);
   launch(cl_.queue(), k_forces_, layout_.n);

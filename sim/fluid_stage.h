@@ -51,7 +51,7 @@ class FluidStage {
   ClRuntime& cl_;
   ParticleStore& store_;
   CoreFields f_;
-  ParticleLayout layout_;
+  const ParticleLayout& layout_;  // the solver's: the particle count changes when water leaves
   fluid::DensityParams density_params_{};
   fluid::ForcesParams forces_params_{};
   cl::Kernel k_density_, k_forces_, k_limits_, k_integrate_;

@@ -67,7 +67,7 @@ class HeatStage {
   HeatPlan plan_;
   double diffusion_dt_ = 0, wall_dt_ = 0, exposed_capacity_ = 0;
   float support_ = 0, smoothing_ = 0, rest_density_ = 0;
-  ParticleLayout layout_;
+  const ParticleLayout& layout_;  // the solver's: the particle count changes when water leaves
   ParticleStore::Field enthalpy_ = 0;
   cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_budget_;
   cl::Buffer materials_, thermal_, lamp_energy_, hits_, budget_parts_, budget_tiles_, budget_bad_, dryers_,

@@ -69,6 +69,7 @@ Metrics measure(const Solver& s) {
   m.steps = s.steps();
   m.clamped = s.clamped();
   m.budget = s.energy_budget();
+  m.outflow = s.outflow();
   m.bodies = bodies_json(s);
   return m;
 }
@@ -107,6 +108,11 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
   j["total_mass"] = m.heat ? m.water_mass + m.ice_mass : m.fluid_mass;
   j["energy"] = {{"kinetic", m.kinetic}, {"potential", m.potential}, {"mechanical", m.kinetic + m.potential}};
   if (!m.bodies.is_null()) j["bodies"] = m.bodies;
+  if (m.outflow.particles)
+    j["outflow"] = {{"particles", m.outflow.particles},
+                    {"mass", m.outflow.mass},
+                    {"momentum", {m.outflow.momentum.x(), m.outflow.momentum.y(), m.outflow.momentum.z()}},
+                    {"enthalpy", m.budget.outflow}};
   if (m.heat) {
     const EnergyBudget& b = m.budget;
     j["mass"] = {{"water", m.water_mass}, {"ice", m.ice_mass}};
@@ -121,6 +127,7 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
           {"dryers", b.dryers},
           {"walls", b.walls},
           {"held", b.held},
+          {"outflow", -b.outflow},
           {"total", b.heat_in()}}},
         {"lamps", {{"emitted", b.lamp_emitted}, {"absorbed", b.lamps}, {"escaped", b.lamp_escaped}}},
         {"closure", m.closure()},

@@ -24,6 +24,7 @@ struct Metrics {
   double enthalpy = 0;                                                    // total sum m h [J]
   double enthalpy_scale = 0;  // sum m |h| [J]: the size round-off is measured against
   EnergyBudget budget;
+  OutflowBooks outflow;  // what left through open sides
   double closure() const { return enthalpy - budget.initial - budget.heat_in(); }
   // Rigid ice (scenes with free ice): one object per body (label, particles, mass, fixed, centre,
   // velocity, angular velocity) and the labelling counters; null otherwise.

@@ -53,8 +53,10 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
     info_.origin[a] = static_cast<float>(scene.domain.min[a]);
   }
   ncells_ = static_cast<std::uint32_t>(double(info_.nx) * info_.ny * info_.nz);
+  // With open sides the keys run to ncells: particles that left sort behind every cell.
+  const std::uint32_t max_key = scene.open_faces ? ncells_ : ncells_ - 1;
   int bits = 1;
-  while (bits < 32 && (ncells_ - 1) >> bits) ++bits;
+  while (bits < 32 && max_key >> bits) ++bits;
   // The fewest radix passes of at most 11 bits, the key's bits spread evenly over them (17 bits: two
   // passes of 9 rather than three of 8).
   sort_passes_ = static_cast<std::uint32_t>((bits + 10) / 11);
@@ -85,8 +87,8 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   cl.queue().enqueueFillBuffer(soa_, 0.0f, 0, std::size_t(layout.stride) * 7 * 4);
 }
 
-void NeighbourGrid::build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped) {
-  if (layout_.n == 0) return;
+std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped) {
+  if (layout_.n == 0) return 0;
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(layout_.n);
   const cl_uint tile = layout_.tile, ntiles = layout_.ntiles;
@@ -95,7 +97,7 @@ void NeighbourGrid::build(ParticleStore& store, const CoreFields& f, const cl::B
   const cl_float4 dmin{{float(d.min.x()), float(d.min.y()), float(d.min.z()), 0.f}};
   const cl_float4 dmax{{float(d.max.x()), float(d.max.y()), float(d.max.z()), 0.f}};
   set_args(k_cell_keys_, store[f.position], store[f.velocity], store[f.phase], keys_[0], order_[0], clamped,
-           g, dmin, dmax, n);
+           g, dmin, dmax, static_cast<cl_uint>(scene_.open_faces), ncells_, n);
   launch(q, k_cell_keys_, layout_.n);
 
   for (std::uint32_t pass = 0; pass < sort_passes_; ++pass) {
@@ -117,6 +119,11 @@ void NeighbourGrid::build(ParticleStore& store, const CoreFields& f, const cl::B
 
   set_args(k_starts_, keys, cell_start_, n, ncells_);
   launch(q, k_starts_, layout_.n + 1);
+  if (!scene_.open_faces) return layout_.n;
+  // cell_start[ncells] is the first particle that left (or n): those behind it are removed.
+  cl_uint kept = 0;
+  q.enqueueReadBuffer(cell_start_, CL_TRUE, std::size_t(ncells_) * 4, 4, &kept);
+  return kept;
 }
 
 std::vector<std::uint32_t> NeighbourGrid::cell_starts() const {

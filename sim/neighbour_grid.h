@@ -31,14 +31,16 @@ class NeighbourGrid {
  public:
   // Cells of support / reach over the domain and every particle (min, max) plus one cell; whole cells
   // along periodic axes. Throws SceneError ("spacing") when the grid would need more than 2^28 cells.
-  // `layout` gives the particle count and the tiles of the sort.
+  // `layout` (the solver's, which must outlive the grid) gives the particle count and the tiles.
   NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, int reach, const std::string& build_options,
                 const ParticleLayout& layout, const Eigen::Vector3f& particle_min,
                 const Eigen::Vector3f& particle_max);
 
-  // Sorts the particles by cell: keys (clamping particles that left the domain back into it and counting
-  // them in `clamped`), the radix sort, the reorder of every field of `store`, the cell ranges.
-  void build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped);
+  // Sorts the particles by cell: keys (clamping particles that left the domain through a closed side
+  // back into it and counting them in `clamped`), the radix sort, the reorder of every field of `store`,
+  // the cell ranges. Returns how many particles are still in: those that left through an open side
+  // (Scene::open_faces) are sorted behind them, in no cell, for the caller to remove.
+  std::size_t build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped);
 
   NeighbourView view() const { return {soa_, layout_.stride, cell_start_, cl_grid(info_)}; }
   const GridInfo& info() const { return info_; }
@@ -49,7 +51,7 @@ class NeighbourGrid {
  private:
   ClRuntime& cl_;
   const Scene& scene_;
-  ParticleLayout layout_;
+  const ParticleLayout& layout_;
   GridInfo info_;
   std::uint32_t ncells_ = 0, sort_passes_ = 0, radix_bits_ = 8;
   cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_scatter_, k_starts_;

@@ -24,16 +24,19 @@ class ParticleStore {
   // (Error otherwise): it names the kernel's arguments.
   Field add(FieldSpec spec);
 
-  // Allocates every field for n particles (and a spare of each for the reorder) and builds the reorder.
-  // Every store has "position" and "velocity" (float4): the reorder also writes their structure-of-arrays
-  // copy that the neighbour loops read.
+  // Allocates every field for a capacity of n particles, all in use, (and a spare of each for the reorder)
+  // and builds the reorder. Every store has "position" and "velocity" (float4): the reorder also writes their
+  // structure-of-arrays copy that the neighbour loops read.
   void allocate(std::size_t n);
 
   cl::Buffer& operator[](Field f) { return buffers_[f]; }
   const cl::Buffer& operator[](Field f) const { return buffers_[f]; }
   const std::vector<FieldSpec>& specs() const { return specs_; }
   bool has(const std::string& name) const;
-  std::size_t size() const { return n_; }
+  std::size_t size() const { return n_; }  // the particles in use
+  std::size_t capacity() const { return capacity_; }
+  // Uses the first n particles of the capacity (particles past n are gone: water that left).
+  void resize(std::size_t n);
   // Bytes of device memory the fields take, spares included.
   std::size_t device_bytes() const;
 
@@ -55,7 +58,7 @@ class ParticleStore {
   ClRuntime& cl_;
   std::vector<FieldSpec> specs_;
   std::vector<cl::Buffer> buffers_, spares_;
-  std::size_t n_ = 0;
+  std::size_t n_ = 0, capacity_ = 0;
   cl::Kernel k_reorder_;
 };
 

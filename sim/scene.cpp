@@ -308,6 +308,11 @@ Scene convert_and_check(Json doc, const std::string& folder) {
 
   s.walls = domain["walls"].get<std::vector<std::string>>();
   s.wall_layers = domain["wall_layers"].get<int>();
+  for (const std::string& side : domain["open"].get<std::vector<std::string>>()) {
+    if (std::find(s.walls.begin(), s.walls.end(), side) != s.walls.end())
+      throw SceneError("domain.open", "side " + side + " has a wall; water cannot leave through it");
+    s.open_faces |= 1u << (2 * (side[1] - 'x') + (side[0] == '+' ? 1 : 0));
+  }
   // Walls lie on the lattice that starts at the domain's lower corner. Along an axis with an upper wall,
   // an extent that is not a whole number of spacings leaves that wall standing off its face: still
   // water ran into the gap and was clamped there (a 5 cm tank at 4 mm: 484,096 clamps in 0.6 s; at

@@ -139,8 +139,11 @@ struct Scene {
   std::string description;
   Box domain;                      // particles leaving it are clamped back and counted
   std::vector<std::string> walls;  // domain sides lined with solid: any of -x +x -y +y -z +z
-  int wall_material = -1;          // material of the domain walls (index), -1 when there are none
-  int wall_layers = 0;             // 0 = as many as hold water (wall_layer_count)
+  // Sides water leaves through (removed and counted as outflow), as bits: 1 -x, 2 +x, 4 -y, 8 +y, 16 -z,
+  // 32 +z. The other sides hold particles at the face (clamped and counted).
+  unsigned open_faces = 0;
+  int wall_material = -1;  // material of the domain walls (index), -1 when there are none
+  int wall_layers = 0;     // 0 = as many as hold water (wall_layer_count)
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};
   double spacing = 0.01;  // particle spacing [m]
   SolverSettings solver;

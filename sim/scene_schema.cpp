@@ -192,6 +192,11 @@ const Field& scene_schema() {
                   subset("walls", {"-x", "+x", "-y", "+y", "-z", "+z"},
                          "Sides of the domain lined with solid")
                       .def(Json::array()),
+                  subset("open", {"-x", "+x", "-y", "+y", "-z", "+z"},
+                         "Sides water may leave through: a fluid particle past one is removed and its mass, "
+                         "momentum and enthalpy counted as outflow (metrics), rather than held at the face; "
+                         "not a side with a wall")
+                      .def(Json::array()),
                   text("wall_material", "Material of the walls, a solid; required when walls is not empty")
                       .optional(),
                   integer("wall_layers",

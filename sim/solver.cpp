@@ -146,11 +146,22 @@ SolverConstants derive_constants(const Scene& scene) {
 }
 
 std::vector<double> EnergyBudget::to_vector() const {
-  return {initial, ambient, lamps, dryers, walls, held, lamp_emitted, lamp_escaped};
+  return {initial, ambient, lamps, dryers, walls, held, lamp_emitted, lamp_escaped, outflow};
+}
+
+OutflowBooks OutflowBooks::from_vector(const std::vector<double>& v) {
+  OutflowBooks b;
+  if (v.empty()) return b;
+  if (v.size() != 5) throw Error("outflow has " + std::to_string(v.size()) + " entries, expected 5");
+  b.particles = static_cast<std::uint64_t>(v[0]);
+  b.mass = v[1];
+  b.momentum = {v[2], v[3], v[4]};
+  return b;
 }
 
 EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
-  if (v.size() != 8) throw Error("energy budget has " + std::to_string(v.size()) + " entries, expected 8");
+  if (v.size() != 8 && v.size() != 9)
+    throw Error("energy budget has " + std::to_string(v.size()) + " entries, expected 9 (8 before outflow)");
   EnergyBudget b;
   b.initial = v[0];
   b.ambient = v[1];
@@ -160,6 +171,7 @@ EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
   b.held = v[5];
   b.lamp_emitted = v[6];
   b.lamp_escaped = v[7];
+  if (v.size() > 8) b.outflow = v[8];
   return b;
 }
 
@@ -266,6 +278,7 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     rigid_->restore({st.rigid_bodies, st.rigid_labelling});
   }
   budget_ = st.energy_budget.empty() ? EnergyBudget{} : EnergyBudget::from_vector(st.energy_budget);
+  outflow_ = OutflowBooks::from_vector(st.outflow);
   if (st.energy_budget.empty()) budget_.initial = total_enthalpy();
 }
 
@@ -302,8 +315,37 @@ void Solver::timed(Stage s, F&& f) {
 }
 
 void Solver::build_grid() {
-  grid_->build(store_, f_, clamped_);
+  const std::size_t kept = grid_->build(store_, f_, clamped_);
+  if (kept < n_) remove_particles_from(kept);
   grid_built_ = true;
+}
+
+void Solver::remove_particles_from(std::size_t kept) {
+  // The sort put the particles that left through an open side behind the others: book them, then use
+  // only the ones before them. Neighbour ranges already end before them (no cell holds them).
+  const std::size_t gone = n_ - kept;
+  auto& q = cl_.queue();
+  std::vector<Float4> x(gone), v(gone);
+  std::vector<std::uint8_t> material(gone);
+  std::vector<std::uint32_t> id(gone);
+  std::vector<Float2> h(gone);
+  q.enqueueReadBuffer(store_[f_.position], CL_FALSE, kept * 16, gone * 16, x.data());
+  q.enqueueReadBuffer(store_[f_.velocity], CL_FALSE, kept * 16, gone * 16, v.data());
+  q.enqueueReadBuffer(store_[f_.material], CL_FALSE, kept, gone, material.data());
+  if (heat_) q.enqueueReadBuffer(store_[heat_->enthalpy()], CL_FALSE, kept * 8, gone * 8, h.data());
+  q.enqueueReadBuffer(store_[f_.id], CL_TRUE, kept * 4, gone * 4, id.data());
+  for (std::size_t k = 0; k < gone; ++k) {
+    if (!heat_) h[k] = fixed_enthalpy_[id[k]];
+    const double mass = double(x[k][3]) * table_[material[k]].thermal_mass_scale;
+    outflow_.mass += mass;
+    outflow_.momentum += mass * Eigen::Vector3d(v[k][0], v[k][1], v[k][2]);
+    budget_.outflow += mass * (double(h[k][0]) + double(h[k][1]));
+  }
+  outflow_.particles += gone;
+  n_ = kept;
+  layout_.n = kept;
+  layout_.ntiles = static_cast<cl_uint>((kept + layout_.tile - 1) / layout_.tile);
+  store_.resize(kept);
 }
 
 void Solver::compute_boundary_psi() {
@@ -556,6 +598,7 @@ SimState Solver::state() const {
   s.clamped = clamped();
   s.scene_json = scene_.source.dump();
   s.energy_budget = budget_.to_vector();
+  if (outflow_.particles) s.outflow = outflow_.to_vector();
   if (rigid_) {
     RigidIce::Saved r = rigid_->save();
     s.rigid_bodies = std::move(r.bodies);

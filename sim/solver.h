@@ -52,9 +52,23 @@ struct EnergyBudget {
   double initial = 0;
   double ambient = 0, lamps = 0, dryers = 0, walls = 0, held = 0;
   double lamp_emitted = 0, lamp_escaped = 0;  // photons: emitted = absorbed (lamps) + escaped
-  double heat_in() const { return ambient + lamps + dryers + walls + held; }
+  double outflow = 0;  // enthalpy m h carried out by water that left through an open side
+  double heat_in() const { return ambient + lamps + dryers + walls + held - outflow; }
   std::vector<double> to_vector() const;
-  static EnergyBudget from_vector(const std::vector<double>& v);  // throws Error on a wrong length
+  // Throws Error on a wrong length; files written before outflow existed have 8 entries (outflow 0).
+  static EnergyBudget from_vector(const std::vector<double>& v);
+};
+
+// What left through the domain's open sides (Scene::open_faces): particles, their physical mass [kg] and
+// momentum [kg m/s]. Mass closes: the fluid's mass now + mass = its mass at the start.
+struct OutflowBooks {
+  std::uint64_t particles = 0;
+  double mass = 0;
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+  std::vector<double> to_vector() const {
+    return {double(particles), mass, momentum.x(), momentum.y(), momentum.z()};
+  }
+  static OutflowBooks from_vector(const std::vector<double>& v);  // empty: nothing has left
 };
 
 class PhotonTracer;
@@ -93,6 +107,7 @@ class Solver {
   // and the budget so far.
   double total_enthalpy() const;
   const EnergyBudget& energy_budget() const { return budget_; }
+  const OutflowBooks& outflow() const { return outflow_; }
 
   SimState state() const;  // copies the device state to the host
   HostParticles particles() const;
@@ -148,6 +163,7 @@ class Solver {
 
  private:
   void compute_boundary_psi();
+  void remove_particles_from(std::size_t kept);  // water past an open side: books, then drop
   ParticleBuffers buffers() const;
   void upload(const HostParticles& p);
   NeighbourView neighbours() const;
@@ -187,6 +203,7 @@ class Solver {
   std::vector<Float2> fixed_enthalpy_;
   std::vector<thermal::MaterialThermal> table_;
   EnergyBudget budget_;
+  OutflowBooks outflow_;
 
   // Rigid ice (built only when the scene has free ice and flow).
   std::unique_ptr<RigidIce> rigid_;

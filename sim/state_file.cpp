@@ -39,6 +39,7 @@ constexpr std::uint32_t field_flags(const FieldSpec& f) {
 constexpr const char* kEnergySection = "energy_budget";
 constexpr const char* kBodiesSection = "rigid_bodies";
 constexpr const char* kLabellingSection = "rigid_labelling";
+constexpr const char* kOutflowSection = "outflow";
 constexpr std::size_t kPrefixBytes = 8 + 4 + 4;  // magic, version, byte order: the same in every version
 constexpr std::size_t kHeaderBytes = kPrefixBytes + 7 * 8 + 2 * 4 + 8;
 constexpr std::size_t kTrailerBytes = 8;
@@ -190,6 +191,7 @@ void for_each_global(State& s, Visit&& visit) {
   visit(kEnergySection, s.energy_budget);
   visit(kBodiesSection, s.rigid_bodies);
   visit(kLabellingSection, s.rigid_labelling);
+  visit(kOutflowSection, s.outflow);
 }
 
 // The arrays of one HostParticles must agree in length before they are written.
@@ -611,6 +613,7 @@ void check_state(const SimState& s, const Scene& scene, const std::string& origi
   all_finite(s.energy_budget, "energy_budget");
   all_finite(s.rigid_bodies, "rigid_bodies");
   all_finite(s.rigid_labelling, "rigid_labelling");
+  all_finite(s.outflow, "outflow");
 }
 
 }  // namespace thaw

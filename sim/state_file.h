@@ -60,6 +60,8 @@ struct SimState {
   // its particle count and their body-frame offsets, which keep it inside the domain. Files written
   // before the section existed resume with 0 sweeps, and before the shapes, with each body's particles.
   std::vector<double> rigid_labelling;
+  // What left through open sides (OutflowBooks::to_vector, global section "outflow"); empty: nothing.
+  std::vector<double> outflow;
 };
 
 // Writes `state` to `path` atomically and durably; throws thaw::Error naming the path and the reason.

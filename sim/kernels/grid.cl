@@ -3,16 +3,27 @@
 
 /* Key of each particle's cell; fluid particles outside the domain are put back on its face, their
  * outward velocity removed, and counted (never silently lost). */
+/* Cell keys. A moving particle past a side of the domain is held at that side (its velocity out of the
+ * domain removed, and counted in `clamped`), unless the side is open (bit 2a of open_faces for the lower
+ * side of axis a, 2a + 1 for the upper): then it has left, and its key is `ncells`, past every cell, so
+ * the sort moves it behind all the others where the solver removes it. */
 kernel void cell_keys(global float4* pos, global float4* vel, global const uchar* phase, global uint* keys,
                       global uint* order, volatile global uint* clamped, const Grid g, const float4 dmin,
-                      const float4 dmax, const uint n) {
+                      const float4 dmax, const uint open_faces, const uint ncells, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   float4 p = pos[i];
+  order[i] = i;
   if (!THAW_IS_STATIC(phase[i])) {
     const int4 below = isless(p, dmin);
     const int4 above = isgreater(p, dmax);
     if (any(below.xyz) || any(above.xyz)) {
+      const uint out = (below.x ? 1u : 0u) | (above.x ? 2u : 0u) | (below.y ? 4u : 0u) | (above.y ? 8u : 0u) |
+                       (below.z ? 16u : 0u) | (above.z ? 32u : 0u);
+      if (out & open_faces) {
+        keys[i] = ncells;
+        return;
+      }
       float4 v = vel[i];
       v = select(v, fmax(v, 0.0f), below);
       v = select(v, fmin(v, 0.0f), above);
@@ -23,7 +34,6 @@ kernel void cell_keys(global float4* pos, global float4* vel, global const uchar
     }
   }
   keys[i] = grid_key(g, grid_cell(g, p));
-  order[i] = i;
 }
 
 /* Radix sort, THAW_RADIX_BITS bits a pass (as many as the cell keys need, spread evenly over the
