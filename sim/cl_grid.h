@@ -11,4 +11,14 @@ struct ClGrid {
 };
 static_assert(sizeof(ClGrid) == 48, "ClGrid must match the OpenCL struct's layout");
 
+// The cell-key pass's parameters: must match `KeysParams` in sim/kernels/grid_common.h.
+struct ClKeysParams {
+  cl_float4 dmin, dmax;  // the domain; w unused
+  cl_uint open_faces;    // Scene::open_faces
+  cl_uint ncells;        // the key of a particle that left through an open side
+  cl_uint n;
+  cl_uint pad;
+};
+static_assert(sizeof(ClKeysParams) == 48, "ClKeysParams must match the OpenCL struct's layout");
+
 }  // namespace thaw

@@ -159,10 +159,6 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
   if (layout_.n == 0) return false;
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(layout_.n);
-  set_args(k_thermal_state_, store_[core_.position], store_[core_.density], store_[enthalpy_],
-           store_[core_.phase], store_[core_.material], materials_, rest_density_,
-           static_cast<cl_int>(scene_.solver.flow ? 1 : 0), thermal_, layout_.stride, n);
-  launch(q, k_thermal_state_, layout_.n);
   if (dryers_dirty_) upload_dryers();
 
   heat::HeatParams P{};
@@ -183,6 +179,12 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
   P.ndryers = static_cast<cl_uint>(scene_.dryers.size());
   P.stride = layout_.stride;
   P.n = n;
+  P.rest_density = rest_density_;
+  P.flow = scene_.solver.flow ? 1u : 0u;
+  set_args(k_thermal_state_, store_[core_.position], store_[core_.density], store_[enthalpy_],
+           store_[core_.phase], store_[core_.material], materials_, thermal_, P);
+  launch(q, k_thermal_state_, layout_.n);
+
   // Without lamps the kernel never touches lamp_energy; any buffer fills the argument.
   const cl::Buffer& lamp_energy = plan_.lamps ? lamp_energy_ : dryers_;
   set_args(k_heat_, store_[core_.position], store_[core_.velocity], store_[enthalpy_], store_[core_.phase],

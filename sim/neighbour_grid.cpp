@@ -94,10 +94,14 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
   const cl_uint tile = layout_.tile, ntiles = layout_.ntiles;
   const ClGrid g = cl_grid(info_);
   const auto& d = scene_.domain;
-  const cl_float4 dmin{{float(d.min.x()), float(d.min.y()), float(d.min.z()), 0.f}};
-  const cl_float4 dmax{{float(d.max.x()), float(d.max.y()), float(d.max.z()), 0.f}};
+  ClKeysParams P{};
+  P.dmin = {{float(d.min.x()), float(d.min.y()), float(d.min.z()), 0.f}};
+  P.dmax = {{float(d.max.x()), float(d.max.y()), float(d.max.z()), 0.f}};
+  P.open_faces = static_cast<cl_uint>(scene_.open_faces);
+  P.ncells = ncells_;
+  P.n = n;
   set_args(k_cell_keys_, store[f.position], store[f.velocity], store[f.phase], keys_[0], order_[0], clamped,
-           g, dmin, dmax, static_cast<cl_uint>(scene_.open_faces), ncells_, n);
+           g, P);
   launch(q, k_cell_keys_, layout_.n);
 
   for (std::uint32_t pass = 0; pass < sort_passes_; ++pass) {

@@ -8,9 +8,10 @@
  * side of axis a, 2a + 1 for the upper): then it has left, and its key is `ncells`, past every cell, so
  * the sort moves it behind all the others where the solver removes it. */
 kernel void cell_keys(global float4* pos, global float4* vel, global const uchar* phase, global uint* keys,
-                      global uint* order, volatile global uint* clamped, const Grid g, const float4 dmin,
-                      const float4 dmax, const uint open_faces, const uint ncells, const uint n) {
+                      global uint* order, volatile global uint* clamped, const Grid g, const KeysParams P) {
   const uint i = get_global_id(0);
+  const uint n = P.n, open_faces = P.open_faces, ncells = P.ncells;
+  const float4 dmin = P.dmin, dmax = P.dmax;
   if (i >= n) return;
   float4 p = pos[i];
   order[i] = i;

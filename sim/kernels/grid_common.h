@@ -23,6 +23,15 @@ typedef struct {
   int nx, ny, nz;
 } Grid;
 
+/* The cell-key pass's parameters. Must match ClKeysParams in sim/cl_grid.h. */
+typedef struct {
+  float4 dmin, dmax;  /* the domain; w unused */
+  uint open_faces;    /* sides water leaves through: bit 2a lower, 2a + 1 upper side of axis a */
+  uint ncells;        /* the key of a particle that left */
+  uint n;             /* particles */
+  uint pad;
+} KeysParams;
+
 int4 grid_cell(const Grid g, float4 p) {
   const int4 c = convert_int4_rtn((p - g.origin) * g.inv_cell);
   return clamp(c, (int4)(0), (int4)(g.nx - 1, g.ny - 1, g.nz - 1, 0));

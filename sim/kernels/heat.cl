@@ -15,9 +15,10 @@
  * the summation density; static particles, and every particle when the flow is off, from rho0. */
 kernel void thermal_state(global const float4* pos, global const float* density, global const float2* enthalpy,
                           global const uchar* phase, global const uchar* material,
-                          global const MaterialThermal* materials, const float rho0, const int flow,
-                          global float* thermal, const uint stride, const uint n) {
+                          global const MaterialThermal* materials, global float* thermal, const HeatParams P) {
   const uint i = get_global_id(0);
+  const uint stride = P.stride, n = P.n, flow = P.flow;
+  const float rho0 = P.rest_density;
   if (i >= n) return;
   const MaterialThermal m = materials[material[i]];
   const float2 e = enthalpy[i];

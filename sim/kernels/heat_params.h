@@ -19,7 +19,9 @@ typedef struct {
   unsigned int ndryers;      /* entries of the dryer table */
   unsigned int stride;       /* length of each structure-of-arrays block */
   unsigned int n;            /* particles */
-  unsigned int pad0, pad1, pad2;
+  float rest_density;        /* rho0: the volume of static particles, and of all with the flow off */
+  unsigned int flow;         /* 1: moving water takes its volume from its summation density */
+  unsigned int pad0;
 } HeatParams;
 
 #ifndef __OPENCL_VERSION__
