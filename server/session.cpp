@@ -700,6 +700,8 @@ void Session::publish() {
     stats["ice_mass"] = m.ice_mass;
     stats["water_mass"] = m.water_mass;
     stats["ice_fraction"] = start_ice_mass_ > 0 ? Json(m.ice_mass / start_ice_mass_) : Json(nullptr);
+    if (const OutflowBooks& out = solver_->outflow(); out.particles)
+      stats["outflow"] = {{"particles", out.particles}, {"mass", out.mass}, {"enthalpy", m.budget.outflow}};
     if (m.heat) {
       const EnergyBudget& b = m.budget;
       const double gross =

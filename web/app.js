@@ -98,6 +98,7 @@ function onEvent(m) {
         `ice ${(1000 * m.ice_mass).toFixed(2)} g (${(100 * m.ice_fraction).toFixed(1)} %)   ` +
         `T mean ${m.temperature.mean.toFixed(2)} °C max ${m.temperature.max.toFixed(1)} °C\n` +
         `particles ${m.particles.water} water, ${m.particles.ice} ice   ` +
+        (m.outflow ? `ran out ${(1000 * m.outflow.mass).toFixed(1)} g   ` : '') +
         `energy closure ${m.energy.closure_relative.toExponential(1)}` + (m.error ? `\nstopped: ${m.error}` : '');
       drawPlot();
       break;

@@ -12,6 +12,7 @@
 #include "server/render_worker.h"
 #include "server/thread_priority.h"
 #include "sim/error.h"
+#include "sim/solver.h"
 #include "tests/test_support.h"
 
 namespace thaw {
@@ -347,6 +348,20 @@ TEST_F(SessionTest, ParamSetOfADryerFieldAppliesInPlaceLikeDryerSet) {
   const Field* speed = find_field(scene_schema(), "dryers[0].speed");
   ASSERT_TRUE(speed);
   EXPECT_TRUE(speed->settable && speed->in_place);
+}
+
+TEST_F(SessionTest, StatsCarryTheWaterThatRanOutThroughAnOpenSide) {
+  auto s = make("dam-break",
+                {"spacing=0.02", "domain.walls=[\"-x\", \"-y\", \"+y\", \"-z\"]", "domain.open=[\"+x\"]"});
+  const std::size_t water = initial_state(*s->scene()).particles.count(Phase::Water);
+  s->start();
+  const auto stats = wait_for_stats(
+      *s, [](const Json& j) { return j.contains("outflow"); }, 120s);
+  ASSERT_TRUE(stats->contains("outflow")) << stats->dump();
+  const Json& out = (*stats)["outflow"];
+  EXPECT_GT(out["particles"].get<std::size_t>(), 0u);
+  EXPECT_GT(out["mass"].get<double>(), 0.0);
+  EXPECT_EQ((*stats)["particles"]["water"].get<std::size_t>() + out["particles"].get<std::size_t>(), water);
 }
 
 TEST_F(SessionTest, BlowUpPausesAndReportsWithoutCrashing) {
