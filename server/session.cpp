@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <future>
-#include <regex>
 
 #include "server/thread_priority.h"
 #include "sim/error.h"
@@ -550,15 +549,15 @@ Session::Outcome Session::apply(const protocol::ParamSet& c) {
   // go: into the running solver between two steps. Any other change rebuilds the solver from the
   // particles as they are, so it takes effect mid-run.
   if (field->in_place) {
-    static const std::regex element(R"(^(dryers|lamps)(?:\[(\d+)\]|\.(\d+))\.)");
-    std::smatch m;
-    if (std::regex_search(c.path, m, element)) {
-      const std::size_t index = std::stoul(m[2].matched ? m[2].str() : m[3].str());
-      const Outcome done = m[1] == "dryers" ? set_dryer(int(index), scene.dryers.at(index))
-                                            : set_lamp(int(index), scene.lamps.at(index));
-      if (done.code) return done;
-      return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}, {"applied", "in place"}}};
-    }
+    // Only dryers' and lamps' fields are marked in place: whichever one the change touched goes into the
+    // running solver, as dryer.set and lamp.set do.
+    for (std::size_t i = 0; i < scene.dryers.size(); ++i)
+      if (to_json(scene.dryers[i]) != to_json(scene_.dryers[i]))
+        if (Outcome done = set_dryer(int(i), scene.dryers[i]); done.code) return done;
+    for (std::size_t i = 0; i < scene.lamps.size(); ++i)
+      if (to_json(scene.lamps[i]) != to_json(scene_.lamps[i]))
+        if (Outcome done = set_lamp(int(i), scene.lamps[i]); done.code) return done;
+    return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}, {"applied", "in place"}}};
   }
   rebuild(std::move(scene), solver_->state(), false);
   return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}, {"applied", "rebuild"}}};

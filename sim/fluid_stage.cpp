@@ -8,6 +8,19 @@
 
 namespace thaw {
 
+fluid::MaterialFlow flow_row(const SolverSettings& s, float rest_density, float kinematic_viscosity,
+                             float sound_speed, float smoothing) {
+  const double rho0 = rest_density, c = sound_speed, c2 = c * c;
+  fluid::MaterialFlow f{};
+  f.rest_density = rest_density;
+  f.stiffness = static_cast<float>(s.eos == Eos::Tait ? rho0 * c2 / s.gamma : rho0 * c2);
+  // Monaghan 2005 eq. 4.8: 2 (d + 2) nu = 10 nu in 3-D, plus the artificial part alpha c h.
+  f.viscosity =
+      static_cast<float>(s.artificial_viscosity * c * double(smoothing) + 10.0 * double(kinematic_viscosity));
+  f.sound_speed = sound_speed;
+  return f;
+}
+
 std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k) {
   int first = -1;
   for (std::size_t b = 0; b < scene.fluids.size(); ++b) {
@@ -15,30 +28,21 @@ std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const S
     if (first >= 0 && scene.materials[m].density != scene.materials[first].density)
       throw SceneError("fluids[" + std::to_string(b) + "].material",
                        "fluids of two rest densities ('" + scene.materials[m].name + "' " +
-                           std::to_string(scene.materials[m].density) + " kg/m^3, '" +
+                           format_number(scene.materials[m].density) + " kg/m^3, '" +
                            scene.materials[first].name + "' " +
-                           std::to_string(scene.materials[first].density) +
+                           format_number(scene.materials[first].density) +
                            " kg/m^3) need the multiphase boundaries and time step of the air model, which "
                            "this build does not have yet; give every fluid block the same rest density");
     if (first < 0) first = m;
   }
-  const double c = k.sound_speed, c2 = c * c, h = k.smoothing;
-  const auto& s = scene.solver;
   std::vector<fluid::MaterialFlow> table;
   for (const Material& m : scene.materials) {
-    fluid::MaterialFlow f{};
     // A boundary material carries rho0 V of the fluid it bounds: the fluid's row (Akinci 2012).
     const bool fluid = m.kind == MaterialKind::Fluid;
-    // In float first, as the kernels see them (and as the single-fluid constants always were).
-    const double rho0 = fluid ? double(static_cast<float>(m.density)) : double(k.rest_density);
-    const double nu =
-        fluid ? double(static_cast<float>(m.viscosity / m.density)) : double(k.kinematic_viscosity);
-    f.rest_density = static_cast<float>(rho0);
-    f.stiffness = static_cast<float>(s.eos == Eos::Tait ? rho0 * c2 / s.gamma : rho0 * c2);
-    // Monaghan 2005 eq. 4.8: 2 (d + 2) nu = 10 nu in 3-D, plus the artificial part alpha c h.
-    f.viscosity = static_cast<float>(s.artificial_viscosity * c * h + 10.0 * nu);
-    f.sound_speed = static_cast<float>(c);
-    table.push_back(f);
+    table.push_back(
+        fluid ? flow_row(scene.solver, static_cast<float>(m.density),
+                         static_cast<float>(m.viscosity / m.density), k.sound_speed, k.smoothing)
+              : flow_row(scene.solver, k.rest_density, k.kinematic_viscosity, k.sound_speed, k.smoothing));
   }
   return table;
 }

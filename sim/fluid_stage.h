@@ -20,6 +20,12 @@ namespace thaw {
 
 struct SolverConstants;
 
+// One material's flow row: the EOS stiffness (Tait B = rho0 c^2 / gamma, or rho0 c^2) and the viscosity
+// coefficient of the pair term, from its rest density and kinematic viscosity (derive_constants gives the
+// first fluid's the same way).
+fluid::MaterialFlow flow_row(const SolverSettings& s, float rest_density, float kinematic_viscosity,
+                             float sound_speed, float smoothing);
+
 // Each material's flow properties, one per Scene::materials (fluid_params.h). Throws SceneError naming
 // the fluid block when the scene has fluids of two rest densities: the passes take them from the table,
 // but the boundaries (Akinci 2012) and the time step still assume one fluid until air lands.

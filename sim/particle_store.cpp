@@ -10,41 +10,29 @@
 
 namespace thaw {
 
-std::size_t scalar_bytes(FieldType t) {
+namespace {
+// Each FieldType's size and its names in OpenCL C and in VTK, in one row.
+struct TypeNames {
+  std::size_t bytes;
+  const char* opencl;
+  const char* vtk;
+};
+TypeNames names_of(FieldType t) {
   switch (t) {
     case FieldType::Float32:
-      return 4;
+      return {4, "float", "Float32"};
     case FieldType::UInt32:
-      return 4;
+      return {4, "uint", "UInt32"};
     case FieldType::UInt8:
-      return 1;
+      return {1, "uchar", "UInt8"};
   }
-  return 0;
+  return {0, "?", "?"};
 }
+}  // namespace
 
-const char* opencl_scalar(FieldType t) {
-  switch (t) {
-    case FieldType::Float32:
-      return "float";
-    case FieldType::UInt32:
-      return "uint";
-    case FieldType::UInt8:
-      return "uchar";
-  }
-  return "?";
-}
-
-const char* vtk_scalar(FieldType t) {
-  switch (t) {
-    case FieldType::Float32:
-      return "Float32";
-    case FieldType::UInt32:
-      return "UInt32";
-    case FieldType::UInt8:
-      return "UInt8";
-  }
-  return "?";
-}
+std::size_t scalar_bytes(FieldType t) { return names_of(t).bytes; }
+const char* opencl_scalar(FieldType t) { return names_of(t).opencl; }
+const char* vtk_scalar(FieldType t) { return names_of(t).vtk; }
 
 std::string FieldSpec::opencl_type() const {
   return std::string(opencl_scalar(type)) + (width > 1 ? std::to_string(width) : "");

@@ -18,6 +18,12 @@
 
 namespace thaw {
 
+std::string format_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 const char* name(MaterialKind k) {
   switch (k) {
     case MaterialKind::Fluid:
@@ -52,12 +58,6 @@ namespace {
 // A sanity limit: beyond this a typo in `spacing` would exhaust memory before any error appears.
 constexpr double kMaxParticles = 20e6;
 constexpr std::array<char, 3> kAxis = {'x', 'y', 'z'};
-
-std::string format_number(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 // 25000000 -> "25,000,000": particle counts are read by people deciding on a spacing.
 std::string format_count(double v) {

@@ -157,6 +157,9 @@ struct Scene {
   Json source;  // the validated document with every default filled in
 };
 
+// A number as messages show it: the shortest form ("0.004", "1100", "1e-09").
+std::string format_number(double v);
+
 // One converter each way per live struct, shared by the scene loader, the solver's live setters and the
 // service's replies. *_from_json takes an element the schema has validated (validate() fills the
 // defaults) and refuses a zero or overflowing direction, naming `path` ("dryers[0]").

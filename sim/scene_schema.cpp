@@ -456,8 +456,9 @@ Fields with a default may be left out. Units are SI; temperatures are in °C.
 
 `--set PATH=VALUE` changes any field before validation, e.g. `--set solver.cfl=0.3`,
 `--set fluids[0].box.max=[0.3,0.2,0.4]`, `--set solver.kernel=wendland_c2` (a value that is not valid
-JSON is taken as a string). Fields with *yes* in the *live* column may also be changed by a connected
-client while the simulation runs.
+JSON is taken as a string). Fields with an entry in the *live* column may also be changed by a connected
+client while the simulation runs (`param.set`): *in place* between two steps, as `dryer.set` does; *rebuild*
+by rebuilding the simulation from the particles as they are.
 
 Checked across fields:
 - `domain.max` is above `domain.min` on every axis, and so is every box's `max` above its `min`;

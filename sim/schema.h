@@ -65,7 +65,8 @@ struct Field {
   Field& at_most(double v);   // <= v
   Field& non_empty();
   Field& client_settable();  // a change rebuilds the solver from the particles as they are
-  Field& live_in_place();    // settable, and applied between two steps without a rebuild
+  Field& live_in_place();    // settable, applied between two steps without a rebuild (dryers and lamps
+                             // only: Session::apply(ParamSet) pushes those into the running solver)
   Field& when(std::string sibling, std::string value);
 
   // Required: no default, not optional, no `when` (objects: some child is required).

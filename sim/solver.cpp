@@ -116,11 +116,11 @@ SolverConstants derive_constants(const Scene& scene) {
   }
   k.sound_speed = static_cast<float>(s.speed_of_sound > 0 ? s.speed_of_sound : s.sound_speed_factor * v_ref);
   const double c2 = double(k.sound_speed) * k.sound_speed;
-  k.stiffness = static_cast<float>(s.eos == Eos::Tait ? k.rest_density * c2 / s.gamma : k.rest_density * c2);
   k.max_speed = static_cast<float>(s.max_speed > 0 ? s.max_speed : 5.0 * k.sound_speed);
   const float h = k.smoothing;
-  k.visc_fluid =
-      static_cast<float>(s.artificial_viscosity * k.sound_speed * h + 10.0 * k.kinematic_viscosity);
+  const fluid::MaterialFlow first = flow_row(s, k.rest_density, k.kinematic_viscosity, k.sound_speed, h);
+  k.stiffness = first.stiffness;
+  k.visc_fluid = first.viscosity;
   k.visc_boundary = static_cast<float>(s.boundary_viscosity * k.sound_speed * h);
   const double dx = scene.spacing;
   k.repulsion = static_cast<float>(c2 / (dx * dx * k.rest_density * dx * dx * dx));
@@ -261,17 +261,13 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     heat_ = std::make_unique<HeatStage>(cl, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
   store_.allocate(n_);
 
-  const auto boundary = cl.build(with_prelude({"boundary.cl"}), opts);
-  k_psi_ = cl::Kernel(boundary, "boundary_psi");
-  k_set_mass_ = cl::Kernel(boundary, "set_mass");
-  scratch_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(n_, 1) * 4);
   clamped_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, 4);
   table_ = material_thermal_table(scene, k_.rest_density);
 
   HostParticles init = p;
   const bool psi_missing = give_boundaries_lattice_mass(init, scene, k_.rest_density);
   upload(init);
-  if (psi_missing && scene.solver.boundary_volume == BoundaryVolume::Akinci2012) compute_boundary_psi();
+  if (psi_missing && scene.solver.boundary_volume == BoundaryVolume::Akinci2012) compute_boundary_psi(opts);
   if (rigid_ && !st.rigid_bodies.empty()) {
     if (!p.column("body") || !p.column("body_offset"))
       throw Error("state: rigid ice bodies without each particle's body and body_offset");
@@ -348,16 +344,20 @@ void Solver::remove_particles_from(std::size_t kept) {
   store_.resize(kept);
 }
 
-void Solver::compute_boundary_psi() {
+void Solver::compute_boundary_psi(const std::string& opts) {
+  // Once, at the start, and only for scenes that ask for Akinci's volumes: built here, not kept.
+  const auto boundary = cl_.build(with_prelude({"boundary.cl"}), opts);
+  cl::Kernel psi(boundary, "boundary_psi"), set_mass(boundary, "set_mass");
+  cl::Buffer scratch(cl_.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(n_, 1) * 4);
   build_grid();
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(n_);
   const ClGrid g = cl_grid(grid_->info());
-  set_args(k_psi_, store_[f_.position], store_[f_.phase], grid_->cell_start(), g, k_.support, k_.rest_density,
-           scratch_, n);
-  launch(q, k_psi_, n_);
-  set_args(k_set_mass_, store_[f_.position], scratch_, n);
-  launch(q, k_set_mass_, n_);
+  set_args(psi, store_[f_.position], store_[f_.phase], grid_->cell_start(), g, k_.support, k_.rest_density,
+           scratch, n);
+  launch(q, psi, n_);
+  set_args(set_mass, store_[f_.position], scratch, n);
+  launch(q, set_mass, n_);
   q.finish();
 }
 
@@ -536,19 +536,15 @@ void Solver::set_lamp(std::size_t index, const Lamp& l) {
 }
 
 std::vector<std::string> Solver::stages() const {
-  const bool flow = scene_.solver.flow;
   std::vector<std::string> out = {"grid"};
-  if (flow) out.insert(out.end(), {"density", "forces"});
+  if (fluid_) out.insert(out.end(), {"density", "forces"});
   if (rigid_) out.push_back("rigid ice");
   out.push_back("time step");
-  if (heat_) {
-    out.push_back(heat_->tracing_photons() ? "photons"
-                  : !scene_.lamps.empty()  ? "photons (when a lamp is on)"
-                                           : "");
-    out.push_back("heat (" + heat_reason_ + ")");
-  }
-  if (flow) out.push_back("integrate");
-  out.erase(std::remove(out.begin(), out.end(), std::string()), out.end());
+  if (heat_ && heat_->tracing_photons()) out.push_back("photons");
+  if (heat_ && !heat_->tracing_photons() && !scene_.lamps.empty())
+    out.push_back("photons (when a lamp is on)");
+  if (heat_) out.push_back("heat (" + heat_reason_ + ")");
+  if (fluid_) out.push_back("integrate");
   return out;
 }
 

@@ -162,8 +162,8 @@ class Solver {
   ThermalInputs thermal_inputs() const;
 
  private:
-  void compute_boundary_psi();
-  void remove_particles_from(std::size_t kept);  // water past an open side: books, then drop
+  void compute_boundary_psi(const std::string& program_options);  // Akinci 2012 eq. 4 volumes, at the start
+  void remove_particles_from(std::size_t kept);                   // water past an open side: books, then drop
   ParticleBuffers buffers() const;
   void upload(const HostParticles& p);
   NeighbourView neighbours() const;
@@ -190,10 +190,8 @@ class Solver {
   bool grid_built_ = false;
   // The water's passes (sim/fluid_stage.h), built only for scenes with flow.
   std::unique_ptr<FluidStage> fluid_;
-  // One float of scratch per particle (the boundary volumes at the start), particles clamped back into
-  // the domain, and the kernels that give boundary particles their mass.
-  cl::Buffer scratch_, clamped_;
-  cl::Kernel k_psi_, k_set_mass_;
+  // Particles clamped back into the domain (counted by the grid's cell-key pass).
+  cl::Buffer clamped_;
 
   // Heat (sim/heat_stage.h), built only when plan_heat says the scene needs it. Without it the enthalpy
   // never changes and stays on the host, by particle id (fixed_enthalpy_). The budget is the run's

@@ -545,11 +545,7 @@ SimState read_state_file(const std::string& path) { return decode_state(path, re
 
 void check_state(const SimState& s, const Scene& scene, const std::string& origin) {
   const auto refuse = [&origin](const std::string& what) { throw Error(origin + ": " + what); };
-  const auto num = [](double v) {
-    std::ostringstream o;
-    o << v;
-    return o.str();
-  };
+  const auto num = format_number;
   if (!std::isfinite(s.time) || s.time < 0) refuse("time " + num(s.time) + " s is not a finite time >= 0");
   if (!std::isfinite(s.dt) || s.dt < 0) refuse("dt " + num(s.dt) + " s is not a finite time step >= 0");
 

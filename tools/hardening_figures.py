@@ -82,15 +82,8 @@ async def backlog(url):
 
 
 async def measure(thaw, label, seconds=8):
-    await thaw.frame()
-    s0 = await thaw.stats()
-    t0, n = time.time(), 0
-    while time.time() - t0 < seconds:
-        await thaw.frame()
-        n += 1
-    s1 = await thaw.stats()
-    wall = time.time() - t0
-    print("%-50s %5.1f frames/s, %4.0f steps/s" % (label, n / wall, (s1["steps"] - s0["steps"]) / wall))
+    fps, steps = await thaw.rates(seconds)
+    print("%-50s %5.1f frames/s, %4.0f steps/s" % (label, fps, steps))
 
 
 async def viewer(url, token):

@@ -19,15 +19,7 @@ import thaw_client
 async def viewer(url, seconds):
     """Frames per second this viewer receives, and the simulation's steps per second meanwhile."""
     async with thaw_client.connect(url) as thaw:
-        await thaw.frame()
-        s0 = await thaw.stats()
-        t0, frames = time.time(), 0
-        while time.time() - t0 < seconds:
-            await thaw.frame()
-            frames += 1
-        s1 = await thaw.stats()
-        wall = time.time() - t0
-        return frames / wall, (s1["steps"] - s0["steps"]) / wall
+        return await thaw.rates(seconds)
 
 
 async def latencies(url, tries):

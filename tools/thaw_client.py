@@ -135,6 +135,19 @@ class Thaw:
                     return f
             await self.frame(max(0.0, deadline - _time.monotonic()))
 
+    async def rates(self, seconds):
+        """Frames a second this client receives over `seconds`, and the simulation's steps a second
+        meanwhile (from the stats before and after)."""
+        await self.frame()
+        s0 = await self.stats()
+        t0, frames = _time.monotonic(), 0
+        while _time.monotonic() - t0 < seconds:
+            await self.frame()
+            frames += 1
+        s1 = await self.stats()
+        wall = _time.monotonic() - t0
+        return frames / wall, (s1["steps"] - s0["steps"]) / wall
+
     async def save_frame(self, path, timeout=30):
         header, jpeg = await self.frame(timeout)
         with open(path, "wb") as f:
