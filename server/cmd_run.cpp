@@ -216,13 +216,18 @@ int cmd_run(int argc, char** argv) {
       std::printf("outflow: %llu particles, %.9g kg, momentum (%.4g, %.4g, %.4g) kg m/s, enthalpy %.6g J\n",
                   (unsigned long long)m.outflow.particles, m.outflow.mass, m.outflow.momentum.x(),
                   m.outflow.momentum.y(), m.outflow.momentum.z(), m.budget.outflow);
+    if (m.inflow.particles)
+      std::printf("inflow: %llu particles, %.9g kg, momentum (%.4g, %.4g, %.4g) kg m/s, enthalpy %.6g J\n",
+                  (unsigned long long)m.inflow.particles, m.inflow.mass, m.inflow.momentum.x(),
+                  m.inflow.momentum.y(), m.inflow.momentum.z(), m.budget.inflow);
     if (m.heat) {
       const EnergyBudget& b = m.budget;
       std::printf(
           "heat: ice %.6g kg, water %.6g kg, temperature %.4g..%.4g °C (mean %.4g); heat in %.6g J "
-          "(ambient %.4g, lamps %.4g, dryers %.4g, walls %.4g, held %.4g), energy closure %.3g J\n",
+          "(ambient %.4g, lamps %.4g, dryers %.4g, walls %.4g, held %.4g, outflow %.4g, inflow %.4g), energy "
+          "closure %.3g J\n",
           m.ice_mass, m.water_mass, m.min_temperature, m.max_temperature, m.mean_temperature, b.heat_in(),
-          b.ambient, b.lamps, b.dryers, b.walls, b.held, m.closure());
+          b.ambient, b.lamps, b.dryers, b.walls, b.held, -b.outflow, b.inflow, m.closure());
     }
     if (!m.bodies.is_null()) {
       int free = 0, fixed = 0;

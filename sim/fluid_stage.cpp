@@ -22,17 +22,22 @@ fluid::MaterialFlow flow_row(const SolverSettings& s, float rest_density, float 
 }
 
 std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k) {
+  // Fluid blocks, then emitters: each names its path for the message.
+  std::vector<std::pair<int, std::string>> users;
+  for (std::size_t b = 0; b < scene.fluids.size(); ++b)
+    users.emplace_back(scene.fluids[b].material, "fluids[" + std::to_string(b) + "].material");
+  for (std::size_t e = 0; e < scene.emitters.size(); ++e)
+    users.emplace_back(scene.emitters[e].material, "emitters[" + std::to_string(e) + "].material");
   int first = -1;
-  for (std::size_t b = 0; b < scene.fluids.size(); ++b) {
-    const int m = scene.fluids[b].material;
+  for (const auto& [m, path] : users) {
     if (first >= 0 && scene.materials[m].density != scene.materials[first].density)
-      throw SceneError("fluids[" + std::to_string(b) + "].material",
-                       "fluids of two rest densities ('" + scene.materials[m].name + "' " +
-                           format_number(scene.materials[m].density) + " kg/m^3, '" +
-                           scene.materials[first].name + "' " +
-                           format_number(scene.materials[first].density) +
-                           " kg/m^3) need the multiphase boundaries and time step of the air model, which "
-                           "this build does not have yet; give every fluid block the same rest density");
+      throw SceneError(path, "fluids of two rest densities ('" + scene.materials[m].name + "' " +
+                                 format_number(scene.materials[m].density) + " kg/m^3, '" +
+                                 scene.materials[first].name + "' " +
+                                 format_number(scene.materials[first].density) +
+                                 " kg/m^3) need the multiphase boundaries and time step of the air model, "
+                                 "which this build does not have yet; give every fluid block and emitter the "
+                                 "same rest density");
     if (first < 0) first = m;
   }
   std::vector<fluid::MaterialFlow> table;
@@ -67,8 +72,8 @@ FluidStage::FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   auto& ctx = cl.context();
   flow_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(fluid::MaterialFlow),
                      const_cast<fluid::MaterialFlow*>(table.data()));
-  const std::size_t n = std::max<std::size_t>(layout.n, 1);
-  const std::size_t tiles = std::max<cl_uint>(layout.ntiles, 1);
+  const std::size_t n = std::max<std::size_t>(layout.capacity, 1);
+  const std::size_t tiles = std::max<cl_uint>(layout.max_tiles, 1);
   auto buf = [&](std::size_t bytes) {
     return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
   };

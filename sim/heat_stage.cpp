@@ -48,8 +48,8 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
 
   auto& ctx = cl.context();
   auto& q = cl.queue();
-  const std::size_t n = std::max<std::size_t>(layout.n, 1);
-  const std::size_t tiles = std::max<cl_uint>(layout.ntiles, 1);
+  const std::size_t n = std::max<std::size_t>(layout.capacity, 1);
+  const std::size_t tiles = std::max<cl_uint>(layout.max_tiles, 1);
   auto buf = [&](std::size_t bytes) {
     return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
   };
@@ -96,7 +96,7 @@ double HeatStage::max_dt() const {
 void HeatStage::lamps_changed() {
   if (photons_) return;
   if (std::none_of(scene_.lamps.begin(), scene_.lamps.end(), [](const Lamp& l) { return l.on; })) return;
-  const std::size_t n = std::max<std::size_t>(layout_.n, 1);
+  const std::size_t n = std::max<std::size_t>(layout_.capacity, 1);
   hits_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, n * 4);
   cl_.queue().enqueueFillBuffer(hits_, cl_uint(0), 0, n * 4);
   photons_ = std::make_unique<PhotonTracer>(cl_, photon_grid_);

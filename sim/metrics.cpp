@@ -70,6 +70,7 @@ Metrics measure(const Solver& s) {
   m.clamped = s.clamped();
   m.budget = s.energy_budget();
   m.outflow = s.outflow();
+  m.inflow = s.inflow();
   m.bodies = bodies_json(s);
   return m;
 }
@@ -113,6 +114,11 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
                     {"mass", m.outflow.mass},
                     {"momentum", {m.outflow.momentum.x(), m.outflow.momentum.y(), m.outflow.momentum.z()}},
                     {"enthalpy", m.budget.outflow}};
+  if (m.inflow.particles)
+    j["inflow"] = {{"particles", m.inflow.particles},
+                   {"mass", m.inflow.mass},
+                   {"momentum", {m.inflow.momentum.x(), m.inflow.momentum.y(), m.inflow.momentum.z()}},
+                   {"enthalpy", m.budget.inflow}};
   if (m.heat) {
     const EnergyBudget& b = m.budget;
     j["mass"] = {{"water", m.water_mass}, {"ice", m.ice_mass}};
@@ -128,6 +134,7 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
           {"walls", b.walls},
           {"held", b.held},
           {"outflow", -b.outflow},
+          {"inflow", b.inflow},
           {"total", b.heat_in()}}},
         {"lamps", {{"emitted", b.lamp_emitted}, {"absorbed", b.lamps}, {"escaped", b.lamp_escaped}}},
         {"closure", m.closure()},

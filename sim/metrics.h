@@ -25,6 +25,7 @@ struct Metrics {
   double enthalpy_scale = 0;  // sum m |h| [J]: the size round-off is measured against
   EnergyBudget budget;
   OutflowBooks outflow;  // what left through open sides
+  InflowBooks inflow;    // what came in through emitters
   double closure() const { return enthalpy - budget.initial - budget.heat_in(); }
   // Rigid ice (scenes with free ice): one object per body (label, particles, mass, fixed, centre,
   // velocity, angular velocity) and the labelling counters; null otherwise.

@@ -71,7 +71,7 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   k_starts_ = cl::Kernel(program, "cell_starts");
 
   auto& ctx = cl.context();
-  const std::size_t n = std::max<std::size_t>(layout.n, 1);
+  const std::size_t n = std::max<std::size_t>(layout.capacity, 1);
   auto buf = [&](std::size_t bytes) {
     return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
   };
@@ -79,7 +79,7 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
     keys_[i] = buf(n * 4);
     order_[i] = buf(n * 4);
   }
-  hist_ = buf((std::size_t(1) << radix_bits_) * std::max<cl_uint>(layout.ntiles, 1) * 4);
+  hist_ = buf((std::size_t(1) << radix_bits_) * std::max<cl_uint>(layout.max_tiles, 1) * 4);
   totals_ = buf((std::size_t(1) << radix_bits_) * 4);
   cell_start_ = buf((std::size_t(ncells_) + 1) * 4);
   soa_ = buf(std::size_t(layout.stride) * 7 * 4);

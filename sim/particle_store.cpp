@@ -114,6 +114,14 @@ void ParticleStore::resize(std::size_t n) {
   n_ = n;
 }
 
+void ParticleStore::clear() {
+  specs_.clear();
+  buffers_.clear();
+  spares_.clear();
+  n_ = capacity_ = 0;
+  k_reorder_ = cl::Kernel();
+}
+
 void ParticleStore::reorder(const cl::Buffer& order, const cl::Buffer& soa, cl_uint stride) {
   if (n_ == 0) return;
   cl_uint a = 0;
@@ -146,20 +154,32 @@ HostSource host_source(const HostParticles& p, const FieldSpec& spec) {
 
 }  // namespace
 
-void ParticleStore::upload(const HostParticles& p) {
-  if (n_ == 0) return;
+void ParticleStore::write(const HostParticles& p, std::size_t first, std::size_t count) {
+  if (count == 0) return;
   auto& q = cl_.queue();
   for (std::size_t f = 0; f < specs_.size(); ++f) {
     const FieldSpec& s = specs_[f];
     const HostSource src = host_source(p, s);
-    if (src.data && src.element == s.bytes() && src.count == n_) {
-      q.enqueueWriteBuffer(buffers_[f], CL_TRUE, 0, n_ * s.bytes(), src.data);
+    const std::size_t offset = first * s.bytes(), bytes = count * s.bytes();
+    if (src.data && src.element == s.bytes() && src.count == count) {
+      q.enqueueWriteBuffer(buffers_[f], CL_TRUE, offset, bytes, src.data);
     } else if (scalar_bytes(s.type) == 4) {
-      q.enqueueFillBuffer(buffers_[f], cl_uint(s.fill), 0, n_ * s.bytes());
+      q.enqueueFillBuffer(buffers_[f], cl_uint(s.fill), offset, bytes);
     } else {
-      q.enqueueFillBuffer(buffers_[f], cl_uchar(s.fill), 0, n_ * s.bytes());
+      q.enqueueFillBuffer(buffers_[f], cl_uchar(s.fill), offset, bytes);
     }
   }
+  q.finish();
+}
+
+void ParticleStore::upload(const HostParticles& p) { write(p, 0, n_); }
+
+void ParticleStore::append(const HostParticles& p) {
+  if (n_ + p.size() > capacity_)
+    throw Error("particle store: " + std::to_string(n_) + " particles and " + std::to_string(p.size()) +
+                " more do not fit in the capacity of " + std::to_string(capacity_));
+  write(p, n_, p.size());
+  n_ += p.size();
 }
 
 void ParticleStore::download(HostParticles& p) const {

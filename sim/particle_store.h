@@ -37,6 +37,11 @@ class ParticleStore {
   std::size_t capacity() const { return capacity_; }
   // Uses the first n particles of the capacity (particles past n are gone: water that left).
   void resize(std::size_t n);
+  // Writes p's particles after the n in use, as upload() does, and uses them too (an emitter's); Error
+  // when they do not fit in the capacity.
+  void append(const HostParticles& p);
+  // Forgets every field and buffer, to be declared and allocated again (the solver growing its capacity).
+  void clear();
   // Bytes of device memory the fields take, spares included.
   std::size_t device_bytes() const;
 
@@ -55,6 +60,8 @@ class ParticleStore {
   std::string reorder_source() const;
 
  private:
+  void write(const HostParticles& p, std::size_t first, std::size_t count);  // p's particles from `first`
+
   ClRuntime& cl_;
   std::vector<FieldSpec> specs_;
   std::vector<cl::Buffer> buffers_, spares_;

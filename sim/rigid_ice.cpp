@@ -76,8 +76,9 @@ RigidBody body_from_vector(const std::vector<double>& v) {
 
 }  // namespace
 
-RigidIce::RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build_options, std::size_t n,
-                   Settings settings, std::vector<std::uint8_t> anchored_by_id, std::vector<float> mass_scale)
+RigidIce::RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build_options,
+                   std::size_t capacity, Settings settings, std::vector<std::uint8_t> anchored_by_id,
+                   std::vector<float> mass_scale)
     : cl_(cl),
       store_(store),
       settings_(std::move(settings)),
@@ -89,7 +90,7 @@ RigidIce::RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build
   labeller_ = std::make_unique<IceLabeller>(cl, settings_.grid_reach);
   reducer_ = std::make_unique<BodyReducer>(cl, mass_scale_);
   auto& ctx = cl.context();
-  const std::size_t m = std::max<std::size_t>(n, 1);
+  const std::size_t m = std::max<std::size_t>(capacity, 1);
   // Each particle's body (kNoBody: none) and its offset in the body's frame, sorted with the particles.
   body_ = store.add({"body", FieldType::UInt32, 1, true, true, kNoBody});
   offset_ = store.add({"body_offset", FieldType::Float32, 4});
@@ -132,8 +133,9 @@ void RigidIce::relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool
   // Grouped by the bodies of the last labelling: melting splits bodies, touching never joins them (ice
   // that froze since, in no body yet, joins what it touches).
   const SortedIceParticles sorted{
-      p.position,   p.phase, p.id,
-      p.cell_start, p.n,     static_cast<std::uint32_t>(std::max<std::size_t>(anchored_by_id_.size(), n)),
+      p.position,   p.phase,
+      p.id,         p.cell_start,
+      p.n,          static_cast<std::uint32_t>(std::max<std::size_t>({anchored_by_id_.size(), n, p.ids})),
       store_[body_]};
   last_iterations_ = static_cast<int>(
       labeller_->label(sorted, p.grid, static_cast<float>(kConnectSpacings * settings_.spacing), label_));

@@ -43,6 +43,7 @@ struct ParticleBuffers {
   const cl::Buffer& cell_start;
   ClGrid grid;
   std::uint32_t n = 0;
+  std::uint32_t ids = 0;  // one past the largest particle id of the run (emitters add ids past n)
 };
 
 // Contact between ice and solids or other ice bodies (Tanaka et al. 2007 as Iwasaki 2010 cites; see
@@ -82,8 +83,8 @@ class RigidIce {
   // for particles of fixed ice objects; `mass_scale[material]` turns a particle's SPH mass into its
   // physical mass (ice is sampled with the fluid's rest mass; sim/thermal.h).
   // Declares its per-particle fields ("body", "body_offset") in `store`, which must outlive it and be
-  // allocated before the first step.
-  RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build_options, std::size_t n,
+  // allocated before the first step; its own per-particle buffers hold `capacity` particles.
+  RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build_options, std::size_t capacity,
            Settings settings, std::vector<std::uint8_t> anchored_by_id, std::vector<float> mass_scale);
   ~RigidIce();
 

@@ -378,8 +378,9 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     check_start(block.material, block.temperature, path + ".temperature");
     s.ice.push_back(block);
   }
-  if (s.fluids.empty() && s.ice.empty())
-    throw SceneError("fluids", "the scene has neither fluid nor ice: add a block to fluids or ice");
+  if (s.fluids.empty() && s.ice.empty() && doc["emitters"].empty())
+    throw SceneError("fluids",
+                     "the scene has neither fluid nor ice nor an emitter: add a block to fluids or ice");
 
   for (std::size_t i = 0; i < doc["solids"].size(); ++i) {
     Json& j = doc["solids"][i];
@@ -414,6 +415,13 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     s.lamps.push_back(lamp_from_json(doc["lamps"][i], join_path("lamps", i)));
   for (std::size_t i = 0; i < doc["dryers"].size(); ++i)
     s.dryers.push_back(dryer_from_json(doc["dryers"][i], join_path("dryers", i)));
+  for (std::size_t i = 0; i < doc["emitters"].size(); ++i) {
+    Json e = doc["emitters"][i];
+    if (!e.contains("temperature")) e["temperature"] = ambient;
+    const std::string path = join_path("emitters", i);
+    s.emitters.push_back(emitter_from_json(e, path, s.materials));
+    check_emitter(s.emitters.back(), s, path);
+  }
 
   for (int a = 0; a < 3; ++a) {
     if (!s.solver.periodic[static_cast<std::size_t>(a)]) continue;
@@ -530,6 +538,78 @@ Lamp lamp_from_json(const Json& j, const std::string& path) {
   l.emissivity = j["emissivity"].get<double>();
   l.photons = j["photons"].get<int>();
   return l;
+}
+
+double Emitter::area() const { return M_PI * radius * radius; }
+
+Json to_json(const Emitter& e, const std::vector<Material>& materials) {
+  const auto v = [](const Eigen::Vector3d& x) { return Json::array({x.x(), x.y(), x.z()}); };
+  return {{"open", e.open},
+          {"material", materials.at(static_cast<std::size_t>(e.material)).name},
+          {"position", v(e.position)},
+          {"direction", v(e.direction)},
+          {"radius", e.radius},
+          {"speed", e.speed},
+          {"temperature", e.temperature},
+          {"start", e.start},
+          {"stop", e.stop}};
+}
+
+Emitter emitter_from_json(const Json& j, const std::string& path, const std::vector<Material>& materials) {
+  Emitter e;
+  e.open = j["open"].get<bool>();
+  const std::string name = j["material"].get<std::string>();
+  const auto it =
+      std::find_if(materials.begin(), materials.end(), [&](const Material& m) { return m.name == name; });
+  if (it == materials.end() || it->kind != MaterialKind::Fluid) {
+    std::string fluids;
+    for (const Material& m : materials)
+      if (m.kind == MaterialKind::Fluid) fluids += (fluids.empty() ? "" : ", ") + m.name;
+    throw SceneError(path + ".material", (it == materials.end() ? "unknown material '" : "material '") +
+                                             name + (it == materials.end() ? "'" : "' is not a fluid") +
+                                             "; an emitter pours a fluid (fluid materials: " +
+                                             (fluids.empty() ? "none" : fluids) + ")");
+  }
+  e.material = static_cast<int>(it - materials.begin());
+  e.position = vec(j["position"]);
+  e.direction = unit_direction(vec(j["direction"]), path + ".direction");
+  e.radius = j["radius"].get<double>();
+  if (j.contains("speed") && j.contains("rate"))
+    throw SceneError(path + ".rate", "give the exit speed or the volume flow rate, not both (speed " +
+                                         format_number(j["speed"].get<double>()) + " m/s, rate " +
+                                         format_number(j["rate"].get<double>()) + " L/s)");
+  e.speed = j.contains("rate")    ? j["rate"].get<double>() * 1e-3 / e.area()
+            : j.contains("speed") ? j["speed"].get<double>()
+                                  : 0.5;
+  if (!(e.speed <= 50))
+    throw SceneError(path + ".rate", format_number(j["rate"].get<double>()) +
+                                         " L/s through a nozzle of radius " + format_number(e.radius) +
+                                         " m is an exit speed of " + format_number(e.speed) +
+                                         " m/s, above the limit of 50 m/s");
+  e.temperature = j.contains("temperature") ? j["temperature"].get<double>() : 20.0;
+  if (it->partner >= 0 && e.temperature < it->melting_point)
+    throw SceneError(path + ".temperature", format_number(e.temperature) +
+                                                " °C is below the freezing point of '" + it->name + "' (" +
+                                                format_number(it->melting_point) +
+                                                " °C); supercooled fluid is not modelled");
+  e.start = j["start"].get<double>();
+  e.stop = j["stop"].get<double>();
+  if (e.stop > 0 && e.stop <= e.start)
+    throw SceneError(path + ".stop", format_number(e.stop) + " s is not after start (" +
+                                         format_number(e.start) + " s); 0 pours for ever");
+  return e;
+}
+
+void check_emitter(const Emitter& e, const Scene& scene, const std::string& path) {
+  if (e.radius < scene.spacing)
+    throw SceneError(path + ".radius", format_number(e.radius) + " m is less than the particle spacing (" +
+                                           format_number(scene.spacing) +
+                                           " m): a nozzle must be at least one particle wide");
+  const Box& d = scene.domain;
+  if ((e.position.array() < d.min.array()).any() || (e.position.array() > d.max.array()).any())
+    throw SceneError(path + ".position", "[" + format_number(e.position.x()) + ", " +
+                                             format_number(e.position.y()) + ", " +
+                                             format_number(e.position.z()) + "] lies outside the domain");
 }
 
 Eigen::Vector3d unit_direction(const Eigen::Vector3d& v, const std::string& path) {

@@ -100,6 +100,23 @@ struct Dryer {
   double nozzle_diameter = 0.04;                          // [m]
 };
 
+// A nozzle that pours fluid (Iwasaki et al. 2010, Fig. 7): layers of particles on the disc of the nozzle,
+// leaving it along `direction` at `speed`, spaced so that the mass flow is rho A v (sim/emitters.h).
+struct Emitter {
+  bool open = true;                                       // the tap: closed, it pours nothing
+  int material = 0;                                       // a fluid (index into Scene::materials)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();     // centre of the nozzle [m]
+  Eigen::Vector3d direction = -Eigen::Vector3d::UnitZ();  // unit, where the fluid leaves
+  double radius = 0.005;                                  // of the nozzle [m]
+  double speed = 0.5;                                     // exit speed [m/s]
+  double temperature = 20.0;                              // of the fluid poured [°C]
+  double start = 0.0;                                     // pours from this time on [s]
+  double stop = 0.0;                                      // and until this time [s]; 0: for ever
+  // The nozzle's area pi r^2 [m^2] and the volume flow A v [m^3/s] it pours while open.
+  double area() const;
+  double volume_flow() const { return area() * speed; }
+};
+
 struct HeatSettings {
   bool enabled = true;
   double time_scale = 1.0;  // heat runs this much faster than the flow
@@ -154,6 +171,7 @@ struct Scene {
   HeatSettings heat;
   std::vector<Lamp> lamps;
   std::vector<Dryer> dryers;
+  std::vector<Emitter> emitters;
   Json source;  // the validated document with every default filled in
 };
 
@@ -167,6 +185,15 @@ Json to_json(const Dryer& d);
 Json to_json(const Lamp& l);
 Dryer dryer_from_json(const Json& j, const std::string& path);
 Lamp lamp_from_json(const Json& j, const std::string& path);
+// An emitter names its material: to_json writes the name, emitter_from_json looks it up among `materials`
+// (a fluid; SceneError at PATH.material otherwise) and takes the exit speed from `rate` [L/s] when the
+// element gives one instead of `speed`.
+Json to_json(const Emitter& e, const std::vector<Material>& materials);
+Emitter emitter_from_json(const Json& j, const std::string& path, const std::vector<Material>& materials);
+// What an emitter needs of the scene: a nozzle at least one spacing wide, inside the domain (SceneError at
+// PATH.radius or PATH.position).
+struct Scene;
+void check_emitter(const Emitter& e, const Scene& scene, const std::string& path);
 
 // `v` scaled to unit length; `path` names it in the SceneError when it is not a vector of moderate size:
 // zero, or so long or so short that its squared length overflows or underflows a double. The protocol

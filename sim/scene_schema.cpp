@@ -437,6 +437,52 @@ const Field& scene_schema() {
               "Hair dryers without air particles: a cone of warm, fast air that heats the exposed surface "
               "inside it (sim/kernels/dryer_model.h has the model).")
               .def(Json::array()),
+          array_of(
+              "emitters",
+              {
+                  flag("open", "The tap: pouring while open (between start and stop)")
+                      .def(true)
+                      .live_in_place(),
+                  text("material", "Name of the fluid material poured"),
+                  vec3("position", "Centre of the nozzle").in("m").live_in_place(),
+                  vec3("direction", "Where the fluid leaves the nozzle; need not be unit length")
+                      .def({0.0, 0.0, -1.0})
+                      .live_in_place(),
+                  number("radius", "Radius of the nozzle; at least one particle spacing")
+                      .in("m")
+                      .def(0.005)
+                      .above(0)
+                      .at_most(1)
+                      .live_in_place(),
+                  number("speed", "Exit speed; default 0.5 m/s unless rate is given")
+                      .in("m/s")
+                      .above(0)
+                      .at_most(50)
+                      .optional()
+                      .live_in_place(),
+                  number("rate", "Volume flow instead of speed: the exit speed is rate / (pi radius^2)")
+                      .in("L/s")
+                      .above(0)
+                      .at_most(1000)
+                      .optional()
+                      .live_in_place(),
+                  number("temperature", "Temperature of the fluid poured; default ambient.temperature")
+                      .in("°C")
+                      .above(-273.15)
+                      .at_most(3000)
+                      .optional()
+                      .live_in_place(),
+                  number("start", "Pours from this time on").in("s").def(0.0).at_least(0).live_in_place(),
+                  number("stop", "Stops pouring at this time; 0: never")
+                      .in("s")
+                      .def(0.0)
+                      .at_least(0)
+                      .live_in_place(),
+              },
+              "Nozzles that pour fluid (Iwasaki et al. 2010, Fig. 7): layers of particles on the nozzle's "
+              "disc leave it along the direction at the exit speed, spaced so that the mass flow is "
+              "rho pi radius^2 speed. A tap a client can open and close (`emitter.set`).")
+              .def(Json::array()),
       });
   return scene;
 }

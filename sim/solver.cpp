@@ -80,6 +80,7 @@ SolverConstants derive_constants(const Scene& scene) {
   // density that boundary particles carry (Akinci 2012) and the stiffness scale; each fluid's own
   // properties are rows of the flow table (material_flow_table in sim/fluid_stage.h).
   int fluid_material = scene.fluids.empty() ? -1 : scene.fluids.front().material;
+  if (fluid_material < 0 && !scene.emitters.empty()) fluid_material = scene.emitters.front().material;
   for (const auto& c : scene.ice)
     if (fluid_material < 0) fluid_material = scene.materials[static_cast<std::size_t>(c.material)].partner;
   const Material* fluid = fluid_material >= 0 ? &scene.materials[fluid_material] : nullptr;
@@ -94,6 +95,7 @@ SolverConstants derive_constants(const Scene& scene) {
   };
   for (const auto& f : scene.fluids) consider(f.material);
   for (const auto& c : scene.ice) consider(scene.materials[static_cast<std::size_t>(c.material)].partner);
+  for (const auto& e : scene.emitters) consider(e.material);
   k.kinematic_viscosity = static_cast<float>(nu);
 
   // Reference speed: free fall from the highest fluid or ice to the bottom of the domain, or the fastest
@@ -110,8 +112,13 @@ SolverConstants derive_constants(const Scene& scene) {
       const double bottom = -scene.domain.max_along(-up);
       if (!scene.fluids.empty() || !scene.ice.empty())
         v_ref = std::sqrt(2.0 * g * std::max(0.0, top - bottom));
+      // A jet lands at sqrt(v^2 + 2 g fall) (a closed tap may open at any time).
+      for (const auto& e : scene.emitters)
+        v_ref = std::max(v_ref,
+                         std::sqrt(e.speed * e.speed + 2.0 * g * std::max(0.0, up.dot(e.position) - bottom)));
     }
     for (const auto& f : scene.fluids) v_ref = std::max(v_ref, f.velocity.norm());
+    for (const auto& e : scene.emitters) v_ref = std::max(v_ref, e.speed);
     v_ref = std::max(v_ref, 0.1);  // a still fluid in zero gravity still needs a finite stiffness
   }
   k.sound_speed = static_cast<float>(s.speed_of_sound > 0 ? s.speed_of_sound : s.sound_speed_factor * v_ref);
@@ -146,7 +153,7 @@ SolverConstants derive_constants(const Scene& scene) {
 }
 
 std::vector<double> EnergyBudget::to_vector() const {
-  return {initial, ambient, lamps, dryers, walls, held, lamp_emitted, lamp_escaped, outflow};
+  return {initial, ambient, lamps, dryers, walls, held, lamp_emitted, lamp_escaped, outflow, inflow};
 }
 
 OutflowBooks OutflowBooks::from_vector(const std::vector<double>& v) {
@@ -160,8 +167,9 @@ OutflowBooks OutflowBooks::from_vector(const std::vector<double>& v) {
 }
 
 EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
-  if (v.size() != 8 && v.size() != 9)
-    throw Error("energy budget has " + std::to_string(v.size()) + " entries, expected 9 (8 before outflow)");
+  if (v.size() < 8 || v.size() > 10)
+    throw Error("energy budget has " + std::to_string(v.size()) +
+                " entries, expected 10 (8 before outflow, 9 before inflow)");
   EnergyBudget b;
   b.initial = v[0];
   b.ambient = v[1];
@@ -172,6 +180,7 @@ EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
   b.lamp_emitted = v[6];
   b.lamp_escaped = v[7];
   if (v.size() > 8) b.outflow = v[8];
+  if (v.size() > 9) b.inflow = v[9];
   return b;
 }
 
@@ -223,51 +232,76 @@ bool give_boundaries_lattice_mass(HostParticles& p, const Scene& scene, float re
 
 // Rigid ice for scenes with free ice and flow; null otherwise.
 std::unique_ptr<RigidIce> make_rigid_ice(ClRuntime& cl, ParticleStore& store, const std::string& opts,
-                                         const Scene& scene, const SolverConstants& k,
-                                         const HostParticles& p) {
+                                         const Scene& scene, const SolverConstants& k, const HostParticles& p,
+                                         std::size_t capacity, std::uint32_t ids) {
   const bool free_ice = std::any_of(scene.ice.begin(), scene.ice.end(),
                                     [](const IceBlock& b) { return b.motion == IceBlock::Motion::Free; });
   if (!free_ice || !scene.solver.flow) return nullptr;
-  const std::size_t n = p.size();
-  std::vector<std::uint8_t> anchored_by_id(n, 0);
-  for (std::size_t i = 0; i < n && i < p.anchored.size(); ++i)
-    if (p.id[i] < n) anchored_by_id[p.id[i]] = p.anchored[i];
-  return std::make_unique<RigidIce>(cl, store, opts, n, rigid_settings(scene, k), std::move(anchored_by_id),
-                                    rigid_mass_scales(scene, k.rest_density));
+  std::vector<std::uint8_t> anchored_by_id(ids, 0);
+  for (std::size_t i = 0; i < p.size() && i < p.anchored.size(); ++i)
+    if (p.id[i] < ids) anchored_by_id[p.id[i]] = p.anchored[i];
+  return std::make_unique<RigidIce>(cl, store, opts, capacity, rigid_settings(scene, k),
+                                    std::move(anchored_by_id), rigid_mass_scales(scene, k.rest_density));
+}
+
+// Room for the emitters' first second beside the particles there are; the solver grows it later.
+std::size_t first_capacity(const Scene& scene, std::size_t n) {
+  if (scene.emitters.empty()) return n;
+  double per_second = 0;
+  for (const Emitter& e : scene.emitters) per_second += EmitterStage::particles_per_second(e, scene.spacing);
+  return n + std::max<std::size_t>(1024, static_cast<std::size_t>(std::ceil(per_second)));
 }
 
 }  // namespace
 
 Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     : cl_(cl), scene_(scene), k_(derive_constants(scene)), store_(cl) {
+  if (!scene_.emitters.empty()) emitters_ = std::make_unique<EmitterStage>(scene_);
+  build(st, 0);
+}
+
+void Solver::build(const SimState& st, std::size_t capacity) {
   const HostParticles& p = st.particles;
   n_ = p.size();
   time_ = st.time;
   dt_ = st.dt;
   steps_ = st.step;
   clamped_base_ = st.clamped;
-  layout_ = layout_for(n_);
-  const auto [lo, hi] = particle_bounds(scene, p);
-  const std::string opts = program_options(scene);
-  const HeatPlan plan = plan_heat(scene, p);
+  const EmitterStage::Saved saved = emitters_ ? emitters_->restore(st.inflow) : EmitterStage::Saved{};
+  std::uint64_t ids = n_ ? std::uint64_t(*std::max_element(p.id.begin(), p.id.end())) + 1 : 0;
+  ids = std::max(ids, saved.next_id);
+  if (ids > 0xffffffffull) throw Error("state: particle ids past 32 bits");
+  next_id_ = static_cast<std::uint32_t>(ids);
+  if (capacity == 0) capacity = saved.capacity ? saved.capacity : first_capacity(scene_, n_);
+  layout_ = layout_for(n_, capacity);
+  const auto [lo, hi] = particle_bounds(scene_, p);
+  const std::string opts = program_options(scene_);
+  const HeatPlan plan = plan_heat(scene_, p);
   heat_reason_ = plan.reason;
 
   // The stages this scene needs, each declaring its fields; then the fields are allocated and filled.
+  rigid_.reset();
+  heat_.reset();
+  fluid_.reset();
+  grid_.reset();
+  store_.clear();
+  grid_built_ = false;
   f_ = add_core_fields(store_);
-  grid_ = std::make_unique<NeighbourGrid>(cl, scene_, k_.support, kGridReach, opts, layout_, lo, hi);
-  if (scene.solver.flow) fluid_ = std::make_unique<FluidStage>(cl, store_, f_, scene_, k_, opts, layout_);
-  rigid_ = make_rigid_ice(cl, store_, opts, scene, k_, p);
+  grid_ = std::make_unique<NeighbourGrid>(cl_, scene_, k_.support, kGridReach, opts, layout_, lo, hi);
+  if (scene_.solver.flow) fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_);
+  rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
   if (plan.build)
-    heat_ = std::make_unique<HeatStage>(cl, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
-  store_.allocate(n_);
+    heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
+  store_.allocate(layout_.capacity);
+  store_.resize(n_);
 
-  clamped_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, 4);
-  table_ = material_thermal_table(scene, k_.rest_density);
+  clamped_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, 4);
+  table_ = material_thermal_table(scene_, k_.rest_density);
 
   HostParticles init = p;
-  const bool psi_missing = give_boundaries_lattice_mass(init, scene, k_.rest_density);
+  const bool psi_missing = give_boundaries_lattice_mass(init, scene_, k_.rest_density);
   upload(init);
-  if (psi_missing && scene.solver.boundary_volume == BoundaryVolume::Akinci2012) compute_boundary_psi(opts);
+  if (psi_missing && scene_.solver.boundary_volume == BoundaryVolume::Akinci2012) compute_boundary_psi(opts);
   if (rigid_ && !st.rigid_bodies.empty()) {
     if (!p.column("body") || !p.column("body_offset"))
       throw Error("state: rigid ice bodies without each particle's body and body_offset");
@@ -281,9 +315,16 @@ Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
 Solver::~Solver() = default;
 
 ParticleBuffers Solver::buffers() const {
-  return {store_[f_.position], store_[f_.velocity],    fluid_->state(),
-          store_[f_.phase],    store_[f_.material],    store_[f_.id],
-          grid_->cell_start(), cl_grid(grid_->info()), static_cast<std::uint32_t>(n_)};
+  return {store_[f_.position],
+          store_[f_.velocity],
+          fluid_->state(),
+          store_[f_.phase],
+          store_[f_.material],
+          store_[f_.id],
+          grid_->cell_start(),
+          cl_grid(grid_->info()),
+          static_cast<std::uint32_t>(n_),
+          next_id_};
 }
 
 void Solver::upload(const HostParticles& p) {
@@ -294,8 +335,7 @@ void Solver::upload(const HostParticles& p) {
     std::vector<Float2> enthalpy = p.enthalpy;
     enthalpy.resize(n_, Float2{0.f, 0.f});
     // Without heat a particle's enthalpy never changes: the host keeps it by id, unsorted.
-    const std::uint32_t ids = n_ ? *std::max_element(p.id.begin(), p.id.end()) + 1 : 0;
-    fixed_enthalpy_.assign(ids, Float2{0.f, 0.f});
+    fixed_enthalpy_.assign(next_id_, Float2{0.f, 0.f});
     for (std::size_t i = 0; i < n_; ++i) fixed_enthalpy_[p.id[i]] = enthalpy[i];
   }
   const cl_uint zero = 0;
@@ -339,9 +379,40 @@ void Solver::remove_particles_from(std::size_t kept) {
   }
   outflow_.particles += gone;
   n_ = kept;
-  layout_.n = kept;
-  layout_.ntiles = static_cast<cl_uint>((kept + layout_.tile - 1) / layout_.tile);
+  layout_.use(kept);
   store_.resize(kept);
+}
+
+void Solver::emit(double dt) {
+  HostParticles in = emitters_->emit(time_ - dt, dt, next_id_);
+  if (in.size() == 0) return;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const double mass = double(in.position[i][3]) * table_[in.material[i]].thermal_mass_scale;
+    budget_.inflow += mass * (double(in.enthalpy[i][0]) + double(in.enthalpy[i][1]));
+  }
+  if (n_ + in.size() > layout_.capacity) {
+    // Out of room: rebuild every stage for half as many again (at least what is needed) from the state,
+    // as a resumed run would; a run resumed from a state file written before this point grows here too.
+    const std::size_t grown = std::max(n_ + in.size(), layout_.capacity + layout_.capacity / 2);
+    const double needed = estimated_memory_bytes(double(grown)), limit = memory_limit_bytes();
+    if (needed > limit) {
+      std::ostringstream os;
+      os << "step " << steps_ << " (t = " << time_ << " s): the emitters have filled the run to " << n_
+         << " particles, and " << grown << " would need about " << needed / 1e9 << " GB, more than the "
+         << limit / 1e9 << " GB available (THAW_MEMORY_LIMIT); close the tap (emitters[].open), set "
+         << "emitters[].stop, or open a side of the domain (domain.open)";
+      throw BlowUpError(os.str());
+    }
+    build(state(), grown);
+  }
+  if (!heat_) {
+    fixed_enthalpy_.resize(next_id_, Float2{0.f, 0.f});
+    for (std::size_t i = 0; i < in.size(); ++i) fixed_enthalpy_[in.id[i]] = in.enthalpy[i];
+  }
+  store_.append(in);
+  n_ = store_.size();
+  layout_.use(n_);
+  grid_built_ = false;
 }
 
 void Solver::compute_boundary_psi(const std::string& opts) {
@@ -492,6 +563,7 @@ void Solver::step() {
   time_ += dt;
   dt_ = dt;
   ++steps_;
+  if (emitters_) timed(Stage::Emit, [&] { emit(dt); });
 }
 
 void Solver::hold_ice(bool held) {
@@ -535,6 +607,26 @@ void Solver::set_lamp(std::size_t index, const Lamp& l) {
   if (heat_) heat_->lamps_changed();
 }
 
+bool Solver::set_emitter(std::size_t index, const Emitter& e) {
+  if (index >= scene_.emitters.size())
+    throw Error("emitter " + std::to_string(index) + " does not exist; the scene has " +
+                std::to_string(scene_.emitters.size()));
+  const std::string path = "emitters[" + std::to_string(index) + "]";
+  Json j = to_json(e, scene_.materials);
+  validate(j, *find_field(scene_schema(), "emitters[0]"), path);
+  const Emitter checked = emitter_from_json(j, path, scene_.materials);
+  check_emitter(checked, scene_, path);
+  if (checked.material != scene_.emitters[index].material) return false;
+  if (!heat_ && checked.temperature != scene_.emitters[index].temperature) return false;
+  // The sound speed was chosen for the fastest water the scene could make (derive_constants): a faster
+  // or higher jet needs a stiffer fluid, so a new solver.
+  Scene next = scene_;
+  next.emitters[index] = checked;
+  if (derive_constants(next).sound_speed > k_.sound_speed) return false;
+  scene_.emitters[index] = checked;
+  return true;
+}
+
 std::vector<std::string> Solver::stages() const {
   std::vector<std::string> out = {"grid"};
   if (fluid_) out.insert(out.end(), {"density", "forces"});
@@ -545,6 +637,7 @@ std::vector<std::string> Solver::stages() const {
     out.push_back("photons (when a lamp is on)");
   if (heat_) out.push_back("heat (" + heat_reason_ + ")");
   if (fluid_) out.push_back("integrate");
+  if (emitters_) out.push_back("emit");
   return out;
 }
 
@@ -595,6 +688,7 @@ SimState Solver::state() const {
   s.scene_json = scene_.source.dump();
   s.energy_budget = budget_.to_vector();
   if (outflow_.particles) s.outflow = outflow_.to_vector();
+  if (emitters_) s.inflow = emitters_->save({next_id_, layout_.capacity});
   if (rigid_) {
     RigidIce::Saved r = rigid_->save();
     s.rigid_bodies = std::move(r.bodies);

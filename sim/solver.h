@@ -1,15 +1,16 @@
 #pragma once
 // Weakly compressible SPH water with static boundary particles, heat with phase change, and ice as rigid
 // bodies, stepped on an OpenCL device. One step (see Solver::step): grid -> [ice labels] -> density ->
-// forces -> [ice forces] -> time step -> photons -> heat -> [bodies] -> integrate; a scene without heat
-// builds no heat stages, one without free ice no rigid stages (sim/rigid_ice.h), one with the flow off
-// none of the fluid ones.
+// forces -> [ice forces] -> time step -> photons -> heat -> [bodies] -> integrate -> [emit]; a scene
+// without heat builds no heat stages, one without free ice no rigid stages (sim/rigid_ice.h), one with the
+// flow off none of the fluid ones, one without emitters no emitter stage (sim/emitters.h).
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "sim/cl_runtime.h"
+#include "sim/emitters.h"
 #include "sim/fluid_stage.h"
 #include "sim/heat_stage.h"
 #include "sim/kernels/thermal_law.h"
@@ -53,9 +54,11 @@ struct EnergyBudget {
   double ambient = 0, lamps = 0, dryers = 0, walls = 0, held = 0;
   double lamp_emitted = 0, lamp_escaped = 0;  // photons: emitted = absorbed (lamps) + escaped
   double outflow = 0;  // enthalpy m h carried out by water that left through an open side
-  double heat_in() const { return ambient + lamps + dryers + walls + held - outflow; }
+  double inflow = 0;   // enthalpy m h brought in by emitters
+  double heat_in() const { return ambient + lamps + dryers + walls + held - outflow + inflow; }
   std::vector<double> to_vector() const;
-  // Throws Error on a wrong length; files written before outflow existed have 8 entries (outflow 0).
+  // Throws Error on a wrong length; files written before outflow existed have 8 entries (outflow 0),
+  // before inflow 9.
   static EnergyBudget from_vector(const std::vector<double>& v);
 };
 
@@ -102,12 +105,22 @@ class Solver {
   void set_lamp(std::size_t index, const Lamp& lamp);
   const std::vector<Dryer>& dryers() const { return scene_.dryers; }
   const std::vector<Lamp>& lamps() const { return scene_.lamps; }
+  // An emitter's tap, speed, place, direction, radius, times and temperature; returns false, changing
+  // nothing, when this run cannot take the change between steps: another material, a temperature that
+  // needs the heat stage this run did not build, or a jet faster (or falling further) than the sound
+  // speed was chosen for (the caller rebuilds the solver from its state).
+  bool set_emitter(std::size_t index, const Emitter& emitter);
+  const std::vector<Emitter>& emitters() const { return scene_.emitters; }
 
   // Heat accounting: the total enthalpy sum m h over all particles now (double, read from the device),
   // and the budget so far.
   double total_enthalpy() const;
   const EnergyBudget& energy_budget() const { return budget_; }
   const OutflowBooks& outflow() const { return outflow_; }
+  // What came in through emitters (zero without them).
+  InflowBooks inflow() const { return emitters_ ? emitters_->books() : InflowBooks{}; }
+  // Particles the buffers hold room for: size() plus the spare that emitters fill (sim/stage.h).
+  std::size_t capacity() const { return layout_.capacity; }
 
   SimState state() const;  // copies the device state to the host
   HostParticles particles() const;
@@ -162,8 +175,12 @@ class Solver {
   ThermalInputs thermal_inputs() const;
 
  private:
+  // Builds the stages this scene needs for `capacity` particles (0: as the state says, or its particles
+  // and the emitters' first second) and loads the state into them: the constructor, and growing.
+  void build(const SimState& state, std::size_t capacity);
   void compute_boundary_psi(const std::string& program_options);  // Akinci 2012 eq. 4 volumes, at the start
   void remove_particles_from(std::size_t kept);                   // water past an open side: books, then drop
+  void emit(double dt);  // the emitters' particles for the step just taken, growing the capacity if need be
   ParticleBuffers buffers() const;
   void upload(const HostParticles& p);
   NeighbourView neighbours() const;
@@ -178,6 +195,7 @@ class Solver {
   double time_ = 0, dt_ = 0;
   std::uint64_t steps_ = 0;
   std::uint64_t clamped_base_ = 0;
+  std::uint32_t next_id_ = 0;  // the id the next emitted particle gets
   double damping_ = 0;
   StageTimers timers_;
   ParticleLayout layout_;
@@ -205,6 +223,8 @@ class Solver {
 
   // Rigid ice (built only when the scene has free ice and flow).
   std::unique_ptr<RigidIce> rigid_;
+  // Emitters (built only when the scene has some); kept when the solver grows its capacity.
+  std::unique_ptr<EmitterStage> emitters_;
 };
 
 // Samples a scene into particles: fluid blocks on a lattice, static solids and domain walls as

@@ -24,24 +24,35 @@ struct NeighbourView {
   ClGrid grid;
 };
 
-// How the particles' arrays are laid out: n particles, structure-of-arrays blocks of `stride` floats, and
-// the tiles of `tile` particles that per-tile reductions (time-step limits, budgets) use.
+// How the particles' arrays are laid out: n particles in use of `capacity` (emitters add particles up to
+// it, open sides remove them), structure-of-arrays blocks of `stride` floats, and the tiles of `tile`
+// particles that per-tile reductions (time-step limits, budgets) use. Stages size their buffers by the
+// capacity (max_tiles tiles) and run over n (ntiles tiles).
 struct ParticleLayout {
-  std::size_t n = 0;
-  cl_uint stride = 0, tile = 256, ntiles = 0;
+  std::size_t n = 0, capacity = 0;
+  cl_uint stride = 0, tile = 256, ntiles = 0, max_tiles = 0;
+
+  // Uses the first n particles of the capacity.
+  void use(std::size_t count) {
+    n = count;
+    ntiles = static_cast<cl_uint>((n + tile - 1) / tile);
+  }
 };
 
-// The layout for n particles: about 32 tiles (whole multiples of 256 particles), enough work-items to
-// keep the cores busy, few enough that each tile's per-digit bookkeeping in the sort is small beside its
-// particles; lane loads (sim/kernels/grid_common.h) read up to 15 floats past the last particle.
-inline ParticleLayout layout_for(std::size_t n) {
+// The layout for a capacity of particles, n of them in use: about 32 tiles of the capacity (whole
+// multiples of 256 particles), enough work-items to keep the cores busy, few enough that each tile's
+// per-digit bookkeeping in the sort is small beside its particles; lane loads
+// (sim/kernels/grid_common.h) read up to 15 floats past the last particle.
+inline ParticleLayout layout_for(std::size_t n, std::size_t capacity) {
   ParticleLayout l;
-  l.n = n;
-  l.tile = static_cast<cl_uint>(std::max<std::size_t>(256, (n / 32 + 255) / 256 * 256));
-  l.ntiles = static_cast<cl_uint>((n + l.tile - 1) / l.tile);
-  l.stride = static_cast<cl_uint>((n + 16 + 15) / 16 * 16);
+  l.capacity = std::max(n, capacity);
+  l.tile = static_cast<cl_uint>(std::max<std::size_t>(256, (l.capacity / 32 + 255) / 256 * 256));
+  l.max_tiles = static_cast<cl_uint>((l.capacity + l.tile - 1) / l.tile);
+  l.stride = static_cast<cl_uint>((l.capacity + 16 + 15) / 16 * 16);
+  l.use(n);
   return l;
 }
+inline ParticleLayout layout_for(std::size_t n) { return layout_for(n, n); }
 
 // The handles of the core fields (core_fields() in sim/particles.h), which most stages read.
 struct CoreFields {

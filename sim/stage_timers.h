@@ -8,10 +8,23 @@
 namespace thaw {
 
 // IceForces and Bodies run only in scenes with free ice (sim/rigid_ice.h): the forces on ice particles,
-// and labelling, per-body sums, rigid integration and placing the ice particles.
-enum class Stage { Grid, Density, Forces, IceForces, TimeStep, Photons, Heat, Bodies, Integrate, Count };
+// and labelling, per-body sums, rigid integration and placing the ice particles. Emit runs only in scenes
+// with emitters (sim/emitters.h), and includes growing the capacity.
+enum class Stage {
+  Grid,
+  Density,
+  Forces,
+  IceForces,
+  TimeStep,
+  Photons,
+  Heat,
+  Bodies,
+  Integrate,
+  Emit,
+  Count
+};
 inline constexpr std::array<const char*, static_cast<int>(Stage::Count)> kStageNames = {
-    "grid", "density", "forces", "ice_forces", "time_step", "photons", "heat", "bodies", "integrate"};
+    "grid", "density", "forces", "ice_forces", "time_step", "photons", "heat", "bodies", "integrate", "emit"};
 
 class StageTimers {
  public:

@@ -40,6 +40,7 @@ constexpr const char* kEnergySection = "energy_budget";
 constexpr const char* kBodiesSection = "rigid_bodies";
 constexpr const char* kLabellingSection = "rigid_labelling";
 constexpr const char* kOutflowSection = "outflow";
+constexpr const char* kInflowSection = "inflow";
 constexpr std::size_t kPrefixBytes = 8 + 4 + 4;  // magic, version, byte order: the same in every version
 constexpr std::size_t kHeaderBytes = kPrefixBytes + 7 * 8 + 2 * 4 + 8;
 constexpr std::size_t kTrailerBytes = 8;
@@ -192,6 +193,7 @@ void for_each_global(State& s, Visit&& visit) {
   visit(kBodiesSection, s.rigid_bodies);
   visit(kLabellingSection, s.rigid_labelling);
   visit(kOutflowSection, s.outflow);
+  visit(kInflowSection, s.inflow);
 }
 
 // The arrays of one HostParticles must agree in length before they are written.
@@ -610,6 +612,7 @@ void check_state(const SimState& s, const Scene& scene, const std::string& origi
   all_finite(s.rigid_bodies, "rigid_bodies");
   all_finite(s.rigid_labelling, "rigid_labelling");
   all_finite(s.outflow, "outflow");
+  all_finite(s.inflow, "inflow");
 }
 
 }  // namespace thaw

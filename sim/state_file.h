@@ -27,7 +27,8 @@
 //                  (HostParticles::columns, e.g. body (u32) and body_offset (four floats) of runs with
 //                  free ice; files written before the type bits existed hold those two untyped).
 //                  Global: energy_budget (doubles), rigid_bodies and rigid_labelling (doubles, only in
-//                  runs with free ice).
+//                  runs with free ice), outflow (runs where water left through an open side), inflow
+//                  (runs with emitters).
 //   checksum       u64      FNV-1a-64 of every byte before it
 // Arrays are named sections so later versions can add per-particle fields (temperature, enthalpy,
 // body id) without breaking readers: a reader skips unknown optional sections and refuses unknown
@@ -62,6 +63,9 @@ struct SimState {
   std::vector<double> rigid_labelling;
   // What left through open sides (OutflowBooks::to_vector, global section "outflow"); empty: nothing.
   std::vector<double> outflow;
+  // Emitters (EmitterStage::save, global section "inflow"): what came in, the next particle id, the
+  // capacity and each emitter's pending length; empty in runs without emitters.
+  std::vector<double> inflow;
 };
 
 // Writes `state` to `path` atomically and durably; throws thaw::Error naming the path and the reason.

@@ -117,7 +117,9 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
   // Temperatures differ by round-off only when each came from the same temperature through a float
   // enthalpy pair: a thousandth of a millikelvin is no difference.
   constexpr double kSame = 1e-6;
-  const std::vector<float> T = temperatures_of(p, scene);
+  // What emitters pour counts as though it were there already (a closed tap may open).
+  std::vector<float> T = temperatures_of(p, scene);
+  for (const Emitter& e : scene.emitters) T.push_back(static_cast<float>(e.temperature));
   const auto [lo, hi] = std::minmax_element(T.begin(), T.end());
   const bool spread = !T.empty() && double(*hi) - double(*lo) > kSame;
   auto differs = [&](double outside) {
@@ -157,6 +159,7 @@ double max_diffusivity(const Scene& scene) {
   };
   for (const auto& f : scene.fluids) use(f.material);
   for (const auto& c : scene.ice) use(c.material);
+  for (const auto& e : scene.emitters) use(e.material);
   for (const auto& s : scene.solids) use(s.material);
   if (!scene.walls.empty()) use(scene.wall_material);
   double alpha = 0;
