@@ -22,7 +22,7 @@
 namespace thaw::protocol {
 namespace {
 
-constexpr int kMaxIndex = 63;              // dryers and lamps a client may address
+constexpr int kMaxIndex = 63;              // dryers, lamps and emitters a client may address
 constexpr std::size_t kMaxIdChars = 256;   // echoed in every reply, so kept short
 constexpr std::size_t kMaxNameChars = 64;  // scene and state names
 constexpr std::size_t kMaxPathChars = 256;
@@ -122,10 +122,10 @@ Field index_field(const std::string& key, const std::string& what) {
 }
 
 // Names only, free of the scene schema: type_name must work even if building the table failed.
-constexpr const char* kTypeNames[] = {"hello",      "dryer.set",  "dryer.aim",    "lamp.set",  "sim.pause",
-                                      "sim.resume", "sim.step",   "sim.reset",    "sim.speed", "scene.load",
-                                      "param.set",  "camera.set", "camera.orbit", "view.set",  "quality.set",
-                                      "state.save", "state.load", "frame.ack"};
+constexpr const char* kTypeNames[] = {"hello",      "dryer.set",  "dryer.aim",    "lamp.set",   "sim.pause",
+                                      "sim.resume", "sim.step",   "sim.reset",    "sim.speed",  "scene.load",
+                                      "param.set",  "camera.set", "camera.orbit", "view.set",   "quality.set",
+                                      "state.save", "state.load", "frame.ack",    "emitter.set"};
 static_assert(std::size(kTypeNames) == std::variant_size_v<Command>, "one name per command");
 
 // ---- the commands, one row each -------------------------------------------------------------------------
@@ -192,6 +192,20 @@ void read_lamp_set(LampSet& c, const Json& v) {
   if (v.contains("normal")) c.normal = nonzero_vec(v["normal"], "normal");
   c.temperature = opt<double>(v, "temperature");
   c.emissivity = opt<double>(v, "emissivity");
+}
+
+void read_emitter_set(EmitterSet& c, const Json& v) {
+  c.emitter = v.at("emitter").get<int>();
+  c.open = opt<bool>(v, "open");
+  if (v.contains("position")) c.position = vec(v["position"]);
+  if (v.contains("direction")) c.direction = nonzero_vec(v["direction"], "direction");
+  c.radius = opt<double>(v, "radius");
+  c.speed = opt<double>(v, "speed");
+  c.rate = opt<double>(v, "rate");
+  if (c.speed && c.rate) throw FieldError{"rate", "give the exit speed or the volume flow rate, not both"};
+  c.temperature = opt<double>(v, "temperature");
+  c.start = opt<double>(v, "start");
+  c.stop = opt<double>(v, "stop");
 }
 
 void read_sim_step(SimStep& c, const Json& v) { c.n = v.at("n").get<int>(); }
@@ -364,15 +378,22 @@ std::vector<Spec> build_specs() {
   rows.push_back(row<FrameAck>(
       "frame.ack", {integer("frame", "Number of the frame received, from its header").at_least(0)},
       read_frame_ack));
+  rows.push_back(
+      row<EmitterSet>("emitter.set",
+                      {index_field("emitter", "emitter"), live("emitters[0].open"),
+                       live("emitters[0].position"), live("emitters[0].direction"),
+                       live("emitters[0].radius"), live("emitters[0].speed"), live("emitters[0].rate"),
+                       live("emitters[0].temperature"), live("emitters[0].start"), live("emitters[0].stop")},
+                      read_emitter_set));
 
   // Rows in variant order, so type_name and needs_controller index them by Command::index().
   std::vector<Spec> ordered(std::variant_size_v<Command>);
-  const std::size_t indices[] = {index_of<Hello>(),       index_of<DryerSet>(),  index_of<DryerAim>(),
-                                 index_of<LampSet>(),     index_of<SimPause>(),  index_of<SimResume>(),
-                                 index_of<SimStep>(),     index_of<SimReset>(),  index_of<SimSpeed>(),
-                                 index_of<SceneLoad>(),   index_of<ParamSet>(),  index_of<CameraSet>(),
-                                 index_of<CameraOrbit>(), index_of<ViewSet>(),   index_of<QualitySet>(),
-                                 index_of<StateSave>(),   index_of<StateLoad>(), index_of<FrameAck>()};
+  const std::size_t indices[] = {
+      index_of<Hello>(),       index_of<DryerSet>(),  index_of<DryerAim>(),   index_of<LampSet>(),
+      index_of<SimPause>(),    index_of<SimResume>(), index_of<SimStep>(),    index_of<SimReset>(),
+      index_of<SimSpeed>(),    index_of<SceneLoad>(), index_of<ParamSet>(),   index_of<CameraSet>(),
+      index_of<CameraOrbit>(), index_of<ViewSet>(),   index_of<QualitySet>(), index_of<StateSave>(),
+      index_of<StateLoad>(),   index_of<FrameAck>(),  index_of<EmitterSet>()};
   static_assert(std::size(indices) == std::variant_size_v<Command>, "one row per command");
   for (std::size_t i = 0; i < rows.size(); ++i) ordered[indices[i]] = std::move(rows[i]);
   for (std::size_t i = 0; i < ordered.size(); ++i) {

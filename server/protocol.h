@@ -18,14 +18,14 @@ inline constexpr std::size_t kMaxMessageBytes = 16 * 1024;  // larger text messa
 
 // Why a message was refused; the `code` of an `error` event.
 enum class ErrorCode {
-  BadJson,        // not JSON, or not a JSON object
-  TooLarge,       // over kMaxMessageBytes
-  UnknownType,    // `type` missing, not a string, or not a command
-  BadField,       // a field missing, of the wrong type, not finite, or out of range
-  Forbidden,      // needs the controller role
-  RateLimited,    // too many commands: the client's bucket is empty
-  NotFound,       // a dryer, lamp, scene or saved state that does not exist
-  Failed,         // valid, but the server could not carry it out (e.g. a state file failed to load)
+  BadJson,      // not JSON, or not a JSON object
+  TooLarge,     // over kMaxMessageBytes
+  UnknownType,  // `type` missing, not a string, or not a command
+  BadField,     // a field missing, of the wrong type, not finite, or out of range
+  Forbidden,    // needs the controller role
+  RateLimited,  // too many commands: the client's bucket is empty
+  NotFound,     // a dryer, lamp, emitter, scene or saved state that does not exist
+  Failed,       // valid, but the server could not carry it out (e.g. a state file failed to load)
 };
 const char* error_code_name(ErrorCode c);
 
@@ -39,7 +39,7 @@ struct Hello {
 struct DryerSet {
   int dryer = 0;
   std::optional<bool> on;
-  std::optional<Eigen::Vector3d> position, direction;  // [m], any length but not zero
+  std::optional<Eigen::Vector3d> position, direction;           // [m], any length but not zero
   std::optional<double> temperature, speed, half_angle, reach;  // °C, m/s, deg, m
 };
 struct DryerAim {  // aim at the surface under a pixel of the client's current image
@@ -51,6 +51,12 @@ struct LampSet {
   std::optional<bool> on;
   std::optional<Eigen::Vector3d> centre, normal;
   std::optional<double> temperature, emissivity;
+};
+struct EmitterSet {  // a tap: open or close it, change its flow, place, aim, times or temperature
+  int emitter = 0;
+  std::optional<bool> open;
+  std::optional<Eigen::Vector3d> position, direction;                   // [m], any length but not zero
+  std::optional<double> radius, speed, rate, temperature, start, stop;  // m, m/s, L/s, °C, s, s
 };
 struct SimPause {};
 struct SimResume {};
@@ -72,18 +78,18 @@ struct CameraSet {
   std::optional<double> azimuth, elevation, distance, fov;
   std::optional<Eigen::Vector3d> target;
 };
-struct CameraOrbit {  // relative change, e.g. from a mouse drag or wheel
+struct CameraOrbit {                                // relative change, e.g. from a mouse drag or wheel
   double d_azimuth = 0, d_elevation = 0, zoom = 1;  // deg, deg, distance factor
 };
 struct ViewSet {
-  std::string view = "surface";  // surface | particles | slice
+  std::string view = "surface";          // surface | particles | slice
   std::optional<std::string> colour_by;  // phase | temperature
 };
 struct QualitySet {
-  std::optional<int> width, height;     // 16 .. 1920, 16 .. 1080
-  std::optional<int> jpeg_quality;      // 10 .. 95
-  std::optional<double> fps;            // frame cap, 1 .. 60
-  std::optional<std::string> surface;   // full | fast
+  std::optional<int> width, height;    // 16 .. 1920, 16 .. 1080
+  std::optional<int> jpeg_quality;     // 10 .. 95
+  std::optional<double> fps;           // frame cap, 1 .. 60
+  std::optional<std::string> surface;  // full | fast
 };
 struct StateSave {
   std::string name;  // [A-Za-z0-9_-]{1,64}: a file in the server's state folder, never a path
@@ -95,9 +101,9 @@ struct FrameAck {
   std::uint64_t frame = 0;
 };
 
-using Command = std::variant<Hello, DryerSet, DryerAim, LampSet, SimPause, SimResume, SimStep, SimReset, SimSpeed,
-                             SceneLoad, ParamSet, CameraSet, CameraOrbit, ViewSet, QualitySet, StateSave,
-                             StateLoad, FrameAck>;
+using Command = std::variant<Hello, DryerSet, DryerAim, LampSet, SimPause, SimResume, SimStep, SimReset,
+                             SimSpeed, SceneLoad, ParamSet, CameraSet, CameraOrbit, ViewSet, QualitySet,
+                             StateSave, StateLoad, FrameAck, EmitterSet>;
 
 // The `type` string of each command, e.g. "dryer.set".
 const char* type_name(const Command& c);

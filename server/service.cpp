@@ -30,14 +30,18 @@ Json vec(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); 
 
 Json dryers_json(const Scene& s) {
   Json out = Json::array();
-  for (const Dryer& d : s.dryers)
-    out.push_back({{"on", d.on},
-                   {"position", vec(d.position)},
-                   {"direction", vec(d.direction)},
-                   {"temperature", d.temperature},
-                   {"speed", d.speed},
-                   {"half_angle", d.half_angle},
-                   {"reach", d.reach}});
+  for (const Dryer& d : s.dryers) out.push_back(to_json(d));
+  return out;
+}
+
+// Each tap as the scene file would say it, with its volume flow in L/s beside the exit speed.
+Json emitters_json(const Scene& s) {
+  Json out = Json::array();
+  for (const Emitter& e : s.emitters) {
+    Json j = to_json(e, s.materials);
+    j["rate"] = e.volume_flow() * 1e3;
+    out.push_back(std::move(j));
+  }
   return out;
 }
 
@@ -65,6 +69,7 @@ Json Service::welcome(bool controller) const {
           {"scene", scene->name},
           {"scenes", scene_names()},
           {"dryers", dryers_json(*scene)},
+          {"emitters", emitters_json(*scene)},
           {"lamps", lamps},
           {"role", controller ? "controller" : "viewer"},
           {"views", {"surface", "particles", "slice"}},
@@ -229,7 +234,9 @@ void Service::on_published() {
     s["encode_ms"] = f->encode_ms;
     s["fps"] = renderer_.fps();
   }
-  s["dryers"] = dryers_json(*session_.scene());
+  const auto scene = session_.scene();
+  s["dryers"] = dryers_json(*scene);
+  s["emitters"] = emitters_json(*scene);
   server_->broadcast_text(s.dump());
 }
 

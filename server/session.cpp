@@ -363,6 +363,7 @@ Session::Outcome Session::apply(const protocol::Command& command, Done& done, bo
       Overloaded{
           [&](const protocol::DryerSet& c) { return apply(c); },
           [&](const protocol::LampSet& c) { return apply(c); },
+          [&](const protocol::EmitterSet& c) { return apply(c); },
           [&](const protocol::SceneLoad& c) { return apply(c); },
           [&](const protocol::ParamSet& c) { return apply(c); },
           [&](const protocol::StateSave& c) { return apply(c); },
@@ -503,6 +504,58 @@ Session::Outcome Session::set_lamp(int index, const Lamp& l) {
   return {std::nullopt, "", result};
 }
 
+Session::Outcome Session::apply(const protocol::EmitterSet& c) {
+  const std::size_t count = solver_->emitters().size();
+  if (c.emitter < 0 || std::size_t(c.emitter) >= count)
+    return {
+        ErrorCode::NotFound,
+        "emitter " + std::to_string(c.emitter) + " does not exist; the scene has " + std::to_string(count),
+        {}};
+  Emitter e = solver_->emitters()[std::size_t(c.emitter)];
+  if (c.open) e.open = *c.open;
+  if (c.position) e.position = *c.position;
+  if (c.direction) e.direction = *c.direction;
+  if (c.radius) e.radius = *c.radius;
+  if (c.speed) e.speed = *c.speed;
+  // A volume flow is the nozzle's (new) area times the exit speed.
+  if (c.rate) e.speed = *c.rate * 1e-3 / e.area();
+  if (c.temperature) e.temperature = *c.temperature;
+  if (c.start) e.start = *c.start;
+  if (c.stop) e.stop = *c.stop;
+  return set_emitter(c.emitter, e);
+}
+
+Session::Outcome Session::set_emitter(int index, const Emitter& e) {
+  const std::size_t i = std::size_t(index);
+  std::string applied = "in place";
+  try {
+    if (!solver_->set_emitter(i, e)) {
+      Scene scene = scene_;
+      scene.emitters[i] = e;
+      rebuild(std::move(scene), solver_->state(), false);
+      applied = "rebuild";
+    }
+  } catch (const Error& err) {
+    return {ErrorCode::BadField, err.what(), {}};
+  }
+  const Emitter& now = solver_->emitters()[i];
+  scene_.emitters[i] = now;
+  Json fields = to_json(now, scene_.materials);
+  Json& source = scene_.source["emitters"][i];
+  source.erase("rate");  // the exit speed says it now
+  for (const auto& [key, value] : fields.items()) source[key] = value;
+  {
+    std::lock_guard lock(publish_mutex_);
+    scene_published_ = std::make_shared<const Scene>(scene_);
+  }
+  dirty_ = true;
+  Json result = fields;
+  result["emitter"] = index;
+  result["rate"] = now.volume_flow() * 1e3;
+  result["applied"] = applied;
+  return {std::nullopt, "", result};
+}
+
 Session::Outcome Session::apply(const protocol::SceneLoad& c) {
   // Only scenes in configs/: a client names one, it never hands the server a path.
   const std::string& name = c.name;
@@ -539,25 +592,39 @@ Session::Outcome Session::apply(const protocol::ParamSet& c) {
   try {
     Json doc = scene_.source;
     apply_override(doc, c.path + "=" + c.value.dump());
+    // An emitter's flow is its exit speed or its volume rate: the one set replaces the other.
+    std::size_t k = 0;
+    char key[8] = {};
+    if (std::sscanf(c.path.c_str(), "emitters[%zu].%7s", &k, key) == 2) {
+      if (std::string(key) == "rate") doc["emitters"][k].erase("speed");
+      if (std::string(key) == "speed") doc["emitters"][k].erase("rate");
+    }
     scene = scene_from_json(std::move(doc));
   } catch (const IndexPastEndError& e) {
     return {ErrorCode::NotFound, e.what(), {}};  // "dryers[5]: index 5 is past the end (...)"
   } catch (const Error& e) {
     return {ErrorCode::BadField, e.what(), {}};
   }
-  // A field the schema marks live in place (a dryer's or a lamp's) goes the way dryer.set and lamp.set
-  // go: into the running solver between two steps. Any other change rebuilds the solver from the
-  // particles as they are, so it takes effect mid-run.
+  // A field the schema marks live in place (a dryer's, a lamp's or an emitter's) goes the way dryer.set,
+  // lamp.set and emitter.set go: into the running solver between two steps. Any other change rebuilds the
+  // solver from the particles as they are, so it takes effect mid-run.
   if (field->in_place) {
-    // Only dryers' and lamps' fields are marked in place: whichever one the change touched goes into the
-    // running solver, as dryer.set and lamp.set do.
+    // Only dryers', lamps' and emitters' fields are marked in place: whichever one the change touched
+    // goes into the running solver, as dryer.set, lamp.set and emitter.set do.
     for (std::size_t i = 0; i < scene.dryers.size(); ++i)
       if (to_json(scene.dryers[i]) != to_json(scene_.dryers[i]))
         if (Outcome done = set_dryer(int(i), scene.dryers[i]); done.code) return done;
     for (std::size_t i = 0; i < scene.lamps.size(); ++i)
       if (to_json(scene.lamps[i]) != to_json(scene_.lamps[i]))
         if (Outcome done = set_lamp(int(i), scene.lamps[i]); done.code) return done;
-    return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}, {"applied", "in place"}}};
+    std::string applied = "in place";
+    for (std::size_t i = 0; i < scene.emitters.size(); ++i)
+      if (to_json(scene.emitters[i], scene.materials) != to_json(scene_.emitters[i], scene_.materials)) {
+        Outcome done = set_emitter(int(i), scene.emitters[i]);
+        if (done.code) return done;
+        applied = done.result["applied"];
+      }
+    return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}, {"applied", applied}}};
   }
   rebuild(std::move(scene), solver_->state(), false);
   return {std::nullopt, "", Json{{"path", c.path}, {"value", c.value}, {"applied", "rebuild"}}};
@@ -701,6 +768,8 @@ void Session::publish() {
     stats["ice_fraction"] = start_ice_mass_ > 0 ? Json(m.ice_mass / start_ice_mass_) : Json(nullptr);
     if (const OutflowBooks& out = solver_->outflow(); out.particles)
       stats["outflow"] = {{"particles", out.particles}, {"mass", out.mass}, {"enthalpy", m.budget.outflow}};
+    if (const InflowBooks in = solver_->inflow(); in.particles)
+      stats["inflow"] = {{"particles", in.particles}, {"mass", in.mass}, {"enthalpy", m.budget.inflow}};
     if (m.heat) {
       const EnergyBudget& b = m.budget;
       const double gross =

@@ -129,6 +129,7 @@ class Session {
   Outcome apply(const protocol::Command& command, Done& done, bool& deferred);
   Outcome apply(const protocol::DryerSet& c);
   Outcome apply(const protocol::LampSet& c);
+  Outcome apply(const protocol::EmitterSet& c);
   Outcome apply(const protocol::SceneLoad& c);
   Outcome apply(const protocol::ParamSet& c);
   Outcome apply(const protocol::StateSave& c);
@@ -138,6 +139,10 @@ class Session {
   // param.set of a field the schema marks live in place).
   Outcome set_dryer(int index, const Dryer& d);
   Outcome set_lamp(int index, const Lamp& l);
+  // An emitter goes in place when the running solver can take it, else by a rebuild from the particles
+  // as they are (a temperature the run has no heat stage for, a jet faster than its sound speed allows);
+  // the result says which ("applied").
+  Outcome set_emitter(int index, const Emitter& e);
 
   void step_once();
   void rebuild(Scene scene, const SimState& state, bool fresh_start);
@@ -152,7 +157,8 @@ class Session {
   std::string state_dir_;
 
   // Owned by the session's thread once started (the constructor's before).
-  Scene scene_;  // source kept in step with live dryer/lamp changes, so state files and rebuilds keep them
+  Scene scene_;  // source kept in step with live dryer/lamp/emitter changes, so state files and rebuilds keep
+                 // them
   std::unique_ptr<Solver> solver_;
   bool running_ = true;
   bool paused_by_error_ = false;

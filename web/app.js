@@ -14,6 +14,7 @@ let nextId = 1;
 let welcome = null;
 let paused = false;
 let dryers = [];          // the scene's dryers as the server last described them
+let emitters = [];        // and its taps (emitters), with their flow in L/s
 let history = [];         // [sim time, ice fraction, mean temperature]
 let reconnectDelay = 500;
 let framesSeen = 0, fpsWindowStart = performance.now(), fps = 0;
@@ -83,14 +84,26 @@ function onEvent(m) {
       $('full-quality').disabled = m.role !== 'controller';
       fillSelect($('scene'), m.scenes || [], m.scene);
       dryers = m.dryers || [];
+      $('dryers').hidden = dryers.length === 0;
       fillSelect($('dryer'), dryers.map((_, i) => String(i)), '0');
       showDryer();
+      emitters = m.emitters || [];
+      $('taps').hidden = emitters.length === 0;
+      fillSelect($('emitter'), emitters.map((_, i) => String(i)), '0');
+      showEmitter();
       history = [];
       break;
     case 'stats':
       paused = !!m.paused;
       $('pause').textContent = paused ? 'Resume' : 'Pause';
       if (m.dryers) dryers = m.dryers;
+      if (m.emitters) {
+        const changed = m.emitters.length !== emitters.length;
+        emitters = m.emitters;
+        $('taps').hidden = emitters.length === 0;
+        if (changed) fillSelect($('emitter'), emitters.map((_, i) => String(i)), '0');
+        showEmitter();
+      }
       history.push([m.time, m.ice_fraction, m.temperature.mean]);
       if (history.length > 2000) history.splice(0, history.length - 2000);
       hud.textContent =
@@ -98,6 +111,7 @@ function onEvent(m) {
         `ice ${(1000 * m.ice_mass).toFixed(2)} g (${(100 * m.ice_fraction).toFixed(1)} %)   ` +
         `T mean ${m.temperature.mean.toFixed(2)} °C max ${m.temperature.max.toFixed(1)} °C\n` +
         `particles ${m.particles.water} water, ${m.particles.ice} ice   ` +
+        (m.inflow ? `poured ${(1000 * m.inflow.mass).toFixed(1)} g   ` : '') +
         (m.outflow ? `ran out ${(1000 * m.outflow.mass).toFixed(1)} g   ` : '') +
         `energy closure ${m.energy.closure_relative.toExponential(1)}` + (m.error ? `\nstopped: ${m.error}` : '');
       drawPlot();
@@ -134,6 +148,21 @@ function showDryer() {
   $('dryer-speed').value = d.speed;
   $('dryer-temp-out').textContent = d.temperature;
   $('dryer-speed-out').textContent = d.speed;
+}
+
+function currentEmitter() {
+  return Number($('emitter').value || 0);
+}
+
+// The tap's controls follow the server, except the slider a user is dragging.
+function showEmitter() {
+  const e = emitters[currentEmitter()];
+  if (!e) return;
+  $('emitter-open').checked = e.open;
+  if (document.activeElement !== $('emitter-rate')) $('emitter-rate').value = e.rate;
+  if (document.activeElement !== $('emitter-temp')) $('emitter-temp').value = e.temperature;
+  $('emitter-rate-out').textContent = Number(e.rate).toFixed(3);
+  $('emitter-temp-out').textContent = Number(e.temperature).toFixed(0);
 }
 
 function drawPlot() {
@@ -208,6 +237,17 @@ $('dryer-temp').addEventListener('input', (e) => {
 $('dryer-speed').addEventListener('input', (e) => {
   $('dryer-speed-out').textContent = e.target.value;
   send('dryer.set', { dryer: currentDryer(), speed: Number(e.target.value) });
+});
+$('emitter').addEventListener('change', showEmitter);
+$('emitter-open').addEventListener('change', (e) => send('emitter.set', { emitter: currentEmitter(), open: e.target.checked }));
+$('emitter-rate').addEventListener('input', (e) => {
+  $('emitter-rate-out').textContent = Number(e.target.value).toFixed(3);
+  send('emitter.set', { emitter: currentEmitter(), rate: Number(e.target.value) });
+});
+$('emitter-temp').addEventListener('change', (e) => {
+  // A change of temperature may rebuild the solver (a run without heat), so it goes on release.
+  $('emitter-temp-out').textContent = e.target.value;
+  send('emitter.set', { emitter: currentEmitter(), temperature: Number(e.target.value) });
 });
 const sendView = () => send('view.set', { view: $('view-kind').value, colour_by: $('colour-by').value });
 $('view-kind').addEventListener('change', sendView);

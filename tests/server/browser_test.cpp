@@ -1,7 +1,8 @@
 // The browser client end to end in headless Chromium (Debian's `chromium`), driven through its DevTools
 // protocol by a Python script on python3-websockets: the page loads and connects, frames arrive and are
 // drawn, a click with "aim" ticked points the dryer at the surface under the pointer (the dryer's
-// direction changes in the stats) and the simulation runs on; a screenshot is saved as an artefact.
+// direction changes in the stats) and the simulation runs on; in a scene with a tap, the tap panel closes
+// and opens it (what has been poured stops and starts growing). Screenshots are saved as artefacts.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -15,16 +16,12 @@ namespace {
 using testing::ServedScene;
 using testing::TempDir;
 
-TEST(BrowserClient, LoadsStreamsAndAimsADryerInHeadlessChromium) {
-  // scripts/debian-packages.txt lists chromium, so scripts/setup installs it: its absence is a broken
-  // set-up, not a reason to pass.
-  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium")) << "Debian's chromium is not installed (scripts/setup)";
-  TempDir dir("browser");
-  ServedScene served(dir, "default --state-dir states");
-  ASSERT_GT(served.port(), 0) << served.log();
-  int status = 0;
-  const std::string out = served.run_python(R"py(
-import asyncio, base64, json, os, socket, subprocess, tempfile, time, urllib.request, websockets
+// A Python program that starts headless Chromium, opens the served page and runs `scenario`: Python
+// source defining `async def scenario(call, js, until)`, where call(method, **params) is a DevTools
+// command, js(expr) evaluates in the page and until(expr, seconds) waits for it to be truthy.
+std::string in_chromium(const std::string& scenario) {
+  return R"py(
+import asyncio, base64, json, os, re, socket, subprocess, tempfile, time, urllib.request, websockets
 s = socket.socket(); s.bind(("127.0.0.1", 0)); DEVTOOLS = s.getsockname()[1]; s.close()
 profile = tempfile.mkdtemp(dir=".")
 chrome = subprocess.Popen(["/usr/bin/chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
@@ -32,6 +29,8 @@ chrome = subprocess.Popen(["/usr/bin/chromium", "--headless", "--no-sandbox", "-
                            "--disable-sync", f"--user-data-dir={profile}", f"--remote-debugging-port={DEVTOOLS}",
                            "--remote-debugging-address=127.0.0.1", "--window-size=1100,700", "about:blank"],
                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+)py" + scenario +
+         R"py(
 try:
     for _ in range(100):
         try:
@@ -64,25 +63,7 @@ try:
             await call("Page.enable")
             await call("Page.navigate", url=f"http://127.0.0.1:{PORT}/")
             print("connected", await until("document.getElementById('connection').textContent === 'connected'", 30))
-            print("frames", bool(await until("framesSeen > 0 || fps > 0", 30)))
-            print("stats", bool(await until("document.getElementById('hud').textContent.includes('ice')", 30)))
-            # The canvas shows the picture, not a blank: many distinct colours in its middle.
-            colours = await js("""(() => { const c = document.getElementById('view');
-                const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; const s = new Set();
-                for (let i = 0; i < d.length; i += 4 * 97) s.add(d[i] + ',' + d[i + 1] + ',' + d[i + 2]);
-                return s.size; })()""")
-            print("colours", colours > 20)
-            before = await js("JSON.stringify(dryers[0].direction)")
-            await js("document.getElementById('aim').click()")
-            box = await js("(() => { const r = document.getElementById('view').getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; })()")
-            x, y = box[0] + 0.40 * box[2], box[1] + 0.42 * box[3]
-            for kind in ("mousePressed", "mouseReleased"):
-                await call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left", clickCount=1)
-            aimed = await until(f"JSON.stringify(dryers[0].direction) !== {json.dumps(before)}", 20)
-            print("aimed", bool(aimed))
-            # The simulation goes on under the new aim (the melt itself is the smoke test's business).
-            t_aim = await js("history.length ? history[history.length - 1][0] : 0")
-            print("running", bool(await until(f"history.length && history[history.length - 1][0] > {t_aim}", 60)))
+            await scenario(call, js, until)
             shot = await call("Page.captureScreenshot", format="png")
             with open("browser.png", "wb") as f:
                 f.write(base64.b64decode(shot["data"]))
@@ -90,11 +71,82 @@ try:
     asyncio.run(main())
 finally:
     chrome.kill()
-)py", 240, &status);
+)py";
+}
+
+void expect_lines(const std::string& out, std::initializer_list<const char*> lines) {
+  for (const char* line : lines) EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
+}
+
+TEST(BrowserClient, LoadsStreamsAndAimsADryerInHeadlessChromium) {
+  // scripts/debian-packages.txt lists chromium, so scripts/setup installs it: its absence is a broken
+  // set-up, not a reason to pass.
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
+      << "Debian's chromium is not installed (scripts/setup)";
+  TempDir dir("browser");
+  ServedScene served(dir, "default --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(in_chromium(R"py(
+async def scenario(call, js, until):
+    print("frames", bool(await until("framesSeen > 0 || fps > 0", 30)))
+    print("stats", bool(await until("document.getElementById('hud').textContent.includes('ice')", 30)))
+    # The canvas shows the picture, not a blank: many distinct colours in its middle.
+    colours = await js("""(() => { const c = document.getElementById('view');
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; const s = new Set();
+        for (let i = 0; i < d.length; i += 4 * 97) s.add(d[i] + ',' + d[i + 1] + ',' + d[i + 2]);
+        return s.size; })()""")
+    print("colours", colours > 20)
+    print("no taps", await js("document.getElementById('taps').hidden"))
+    before = await js("JSON.stringify(dryers[0].direction)")
+    await js("document.getElementById('aim').click()")
+    box = await js("(() => { const r = document.getElementById('view').getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; })()")
+    x, y = box[0] + 0.40 * box[2], box[1] + 0.42 * box[3]
+    for kind in ("mousePressed", "mouseReleased"):
+        await call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left", clickCount=1)
+    aimed = await until(f"JSON.stringify(dryers[0].direction) !== {json.dumps(before)}", 20)
+    print("aimed", bool(aimed))
+    # The simulation goes on under the new aim (the melt itself is the smoke test's business).
+    t_aim = await js("history.length ? history[history.length - 1][0] : 0")
+    print("running", bool(await until(f"history.length && history[history.length - 1][0] > {t_aim}", 60)))
+)py"),
+                                            240, &status);
   EXPECT_EQ(status, 0) << out;
-  for (const char* line : {"connected True", "frames True", "stats True", "colours True", "aimed True", "running True",
-                           "screenshot True"})
-    EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
+  expect_lines(out, {"connected True", "frames True", "stats True", "colours True", "no taps True",
+                     "aimed True", "running True", "screenshot True"});
+  std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
+  EXPECT_TRUE(served.stop()) << served.log();
+}
+
+// The tap panel of a scene with an emitter: it shows, closing the tap stops what is poured from growing
+// while the simulation runs on, and opening it again pours more.
+TEST(BrowserClient, TheTapPanelClosesAndOpensAnEmitter) {
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
+      << "Debian's chromium is not installed (scripts/setup)";
+  TempDir dir("browser-tap");
+  ServedScene served(dir, "pour-into-glass --set spacing=0.005 --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(in_chromium(R"py(
+POURED = "(() => { const m = document.getElementById('hud').textContent.match(/poured ([0-9.]+) g/); return m ? Number(m[1]) : 0; })()"
+SIM_TIME = "(history.length ? history[history.length - 1][0] : 0)"
+async def scenario(call, js, until):
+    print("taps shown", await until("!document.getElementById('taps').hidden && emitters.length === 1", 30))
+    print("pouring", bool(await until(f"{POURED} > 0", 60)))
+    await js("document.getElementById('emitter-open').click()")
+    print("closed", bool(await until("emitters[0].open === false", 20)))
+    closed = await js(POURED)
+    t_closed = await js(SIM_TIME)
+    print("ran on", bool(await until(f"{SIM_TIME} > {t_closed} + 0.02", 60)))
+    print("held", await js(POURED) == closed)
+    await js("document.getElementById('emitter-open').click()")
+    print("opened", bool(await until("emitters[0].open === true", 20)))
+    print("pours again", bool(await until(f"{POURED} > {closed}", 60)))
+)py"),
+                                            240, &status);
+  EXPECT_EQ(status, 0) << out;
+  expect_lines(out, {"connected True", "taps shown True", "pouring True", "closed True", "ran on True",
+                     "held True", "opened True", "pours again True", "screenshot True"});
   std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
   EXPECT_TRUE(served.stop()) << served.log();
 }

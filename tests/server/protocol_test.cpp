@@ -78,6 +78,8 @@ const std::vector<std::string>& valid_messages() {
       R"({"type":"state.save","name":"before_melt"})",
       R"({"type":"state.load","name":"before_melt"})",
       R"({"type":"frame.ack","frame":42})",
+      R"({"type":"emitter.set","emitter":0,"open":true,"position":[0.04,0.04,0.09],"direction":[0,1,-2],)"
+      R"("radius":0.006,"speed":0.8,"temperature":40,"start":0.5,"stop":3})",
   };
   return messages;
 }
@@ -167,6 +169,27 @@ TEST(ProtocolParse, LampSet) {
   const LampSet few = parsed<LampSet>(R"({"type":"lamp.set","lamp":5,"emissivity":1})");
   EXPECT_EQ(few.lamp, 5);
   EXPECT_FALSE(few.on || few.centre || few.normal || few.temperature);
+}
+
+TEST(ProtocolParse, EmitterSet) {
+  const EmitterSet e = parsed<EmitterSet>(valid_messages().back());
+  EXPECT_EQ(e.emitter, 0);
+  EXPECT_EQ(e.open, true);
+  EXPECT_EQ(*e.position, Eigen::Vector3d(0.04, 0.04, 0.09));
+  EXPECT_EQ(*e.direction, Eigen::Vector3d(0, 1, -2));
+  EXPECT_EQ(e.radius, 0.006);
+  EXPECT_EQ(e.speed, 0.8);
+  EXPECT_FALSE(e.rate);
+  EXPECT_EQ(e.temperature, 40.0);
+  EXPECT_EQ(e.start, 0.5);
+  EXPECT_EQ(e.stop, 3.0);
+  // The tap alone, or a flow in litres per second: nothing else is filled in.
+  const EmitterSet tap = parsed<EmitterSet>(R"({"type":"emitter.set","emitter":2,"open":false})");
+  EXPECT_EQ(tap.emitter, 2);
+  EXPECT_EQ(tap.open, false);
+  EXPECT_FALSE(tap.position || tap.direction || tap.radius || tap.speed || tap.rate || tap.temperature ||
+               tap.start || tap.stop);
+  EXPECT_EQ(parsed<EmitterSet>(R"({"type":"emitter.set","emitter":0,"rate":0.05})").rate, 0.05);
 }
 
 TEST(ProtocolParse, SimulationControl) {
@@ -435,6 +458,24 @@ TEST(ProtocolRefuse, LampSet) {
   });
 }
 
+TEST(ProtocolRefuse, EmitterSet) {
+  const std::string e = R"({"type":"emitter.set","emitter":0,)";
+  expect_bad_fields({
+      {R"({"type":"emitter.set","open":true})", "emitter.set", "emitter"},
+      {R"({"type":"emitter.set","emitter":64})", "emitter.set", "emitter"},
+      {e + R"("open":1})", "emitter.set", "open"},
+      {e + R"("direction":[0,0,0]})", "emitter.set", "direction"},
+      {e + R"("radius":0})", "emitter.set", "radius"},
+      {e + R"("speed":0})", "emitter.set", "speed"},
+      {e + R"("speed":51})", "emitter.set", "speed"},
+      {e + R"("rate":-1})", "emitter.set", "rate"},
+      {e + R"("speed":1,"rate":0.1})", "emitter.set", "rate"},
+      {e + R"("temperature":-300})", "emitter.set", "temperature"},
+      {e + R"("stop":-1})", "emitter.set", "stop"},
+      {e + R"("material":"water"})", "emitter.set", "material"},
+  });
+}
+
 TEST(ProtocolRefuse, SimulationControl) {
   expect_bad_fields({
       {R"({"type":"sim.step","n":0})", "sim.step", "n"},
@@ -557,6 +598,7 @@ TEST(ProtocolRoles, NeedsControllerForWhatEveryoneSees) {
     EXPECT_EQ(needs_controller(c), !presentation) << type_name(c);
   }
   EXPECT_TRUE(needs_controller(DryerSet{}));
+  EXPECT_TRUE(needs_controller(EmitterSet{}));
   EXPECT_TRUE(needs_controller(ParamSet{}));
   EXPECT_TRUE(needs_controller(StateLoad{}));
   EXPECT_FALSE(needs_controller(FrameAck{}));

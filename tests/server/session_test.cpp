@@ -350,6 +350,68 @@ TEST_F(SessionTest, ParamSetOfADryerFieldAppliesInPlaceLikeDryerSet) {
   EXPECT_TRUE(speed->settable && speed->in_place);
 }
 
+// A tap a client turns (emitter.set, and param.set of an emitter's field): closing and opening it and a
+// slower flow go into the running solver; a faster jet than the run's sound speed was chosen for
+// rebuilds it from the particles as they are, keeping what has come in; a tap that does not exist is
+// not_found, a bad value a bad field.
+TEST_F(SessionTest, EmitterSetTurnsTheTapInPlaceOrRebuildsForAFasterJet) {
+  auto s = make("pour-into-glass");
+  s->start();
+  wait_for_stats(*s, [](const Json& j) { return j["steps"].get<std::uint64_t>() >= 1; });
+  ASSERT_FALSE(call(*s, protocol::SimPause{}).code);
+  const auto inflow = [&] {
+    const Json stats = *s->latest_stats();
+    return stats.contains("inflow") ? stats["inflow"]["particles"].get<std::uint64_t>() : 0;
+  };
+  protocol::EmitterSet close;
+  close.open = false;
+  Reply r = call(*s, close);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["applied"], "in place");
+  EXPECT_EQ(r.result["open"], false);
+  ASSERT_FALSE(call(*s, protocol::SimStep{200}).code);
+  const std::uint64_t closed = inflow();
+  ASSERT_FALSE(call(*s, protocol::SimStep{200}).code);
+  EXPECT_EQ(inflow(), closed) << "a closed tap poured";
+
+  protocol::EmitterSet open;
+  open.open = true;
+  open.rate = 0.05;  // L/s, slower than the scene's 0.08
+  r = call(*s, open);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["applied"], "in place");
+  EXPECT_NEAR(r.result["rate"].get<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(s->scene()->emitters.at(0).volume_flow(), 0.05e-3, 1e-15);
+  EXPECT_FALSE(s->scene()->source["emitters"][0].contains("rate")) << "the exit speed says it now";
+  ASSERT_FALSE(call(*s, protocol::SimStep{400}).code);
+  const std::uint64_t poured = inflow();
+  EXPECT_GT(poured, closed);
+
+  protocol::EmitterSet fast;
+  fast.speed = 6.0;
+  r = call(*s, fast);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["applied"], "rebuild");
+  EXPECT_EQ(s->scene()->emitters.at(0).speed, 6.0);
+  EXPECT_EQ(inflow(), poured) << "the rebuild keeps the books of what came in";
+  ASSERT_FALSE(call(*s, protocol::SimStep{100}).code);
+  EXPECT_GT(inflow(), poured);
+
+  r = call(*s, protocol::ParamSet{"emitters[0].rate", 0.02});
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["applied"], "in place");
+  EXPECT_NEAR(s->scene()->emitters.at(0).volume_flow(), 0.02e-3, 1e-15);
+
+  protocol::EmitterSet missing;
+  missing.emitter = 3;
+  EXPECT_EQ(call(*s, missing).code, ErrorCode::NotFound);
+  protocol::EmitterSet narrow;
+  narrow.radius = 0.001;
+  r = call(*s, narrow);
+  EXPECT_EQ(r.code, ErrorCode::BadField);
+  EXPECT_NE(r.message.find("emitters[0].radius"), std::string::npos) << r.message;
+}
+
 TEST_F(SessionTest, StatsCarryTheWaterThatRanOutThroughAnOpenSide) {
   auto s = make("dam-break",
                 {"spacing=0.02", "domain.walls=[\"-x\", \"-y\", \"+y\", \"-z\"]", "domain.open=[\"+x\"]"});
