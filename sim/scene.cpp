@@ -224,6 +224,97 @@ Box box_of(const Shape& shape) { return {shape.bounds().min(), shape.bounds().ma
 
 // Checks that span several fields; `doc` has passed validation, so every field is present and typed.
 // `folder` is where relative mesh paths are looked for first.
+// ---- one converter per scene struct (lamps, dryers, emitters and the solver settings have theirs below,
+// being live or read on their own) ----------------------------------------------------------------------
+
+Material material_from_json(const std::string& name, const Json& m) {
+  Material mat;
+  mat.name = name;
+  mat.kind =
+      choice_of<MaterialKind>(m["kind"], {MaterialKind::Fluid, MaterialKind::Solid, MaterialKind::Ice});
+  mat.density = m["density"].get<double>();
+  mat.viscosity = m["viscosity"].get<double>();
+  mat.conductivity = m["conductivity"].get<double>();
+  mat.specific_heat = m["specific_heat"].get<double>();
+  return mat;
+}
+
+// Heat, from the document's heat, ambient and domain.wall_heat blocks.
+HeatSettings heat_settings_from_json(const Json& doc) {
+  HeatSettings h;
+  h.enabled = doc["heat"]["enabled"].get<bool>();
+  h.time_scale = doc["heat"]["time_scale"].get<double>();
+  h.exposed_area = choice_of<ExposedArea>(doc["heat"]["exposed_area"], {ExposedArea::Iwasaki2010});
+  h.ambient_temperature = doc["ambient"]["temperature"].get<double>();
+  h.ambient_coefficient = doc["ambient"]["heat_transfer_coefficient"].get<double>();
+  h.wall_coefficient = doc["domain"]["wall_heat"]["coefficient"].get<double>();
+  h.wall_temperature = doc["domain"]["wall_heat"]["temperature"].get<double>();
+  return h;
+}
+
+double temperature_or(const Json& object, double fallback) {
+  return object.contains("temperature") ? object["temperature"].get<double>() : fallback;
+}
+
+// Phase-changing materials start on their own side of the melting point (no supercooled water here).
+void check_start(const Scene& s, int material, double T, const std::string& path) {
+  const Material& m = s.materials[static_cast<std::size_t>(material)];
+  if (m.partner < 0) return;
+  if (m.kind == MaterialKind::Ice && T > m.melting_point)
+    throw SceneError(path, format_number(T) + " °C is above the melting point of '" + m.name + "' (" +
+                               format_number(m.melting_point) + " °C)");
+  if (m.kind == MaterialKind::Fluid && T < m.melting_point)
+    throw SceneError(path, format_number(T) + " °C is below the freezing point of '" + m.name + "' (" +
+                               format_number(m.melting_point) + " °C); supercooled fluid is not modelled");
+}
+
+// `materials` is the document's block, for the names; `s` has the domain, the materials and the ambient
+// temperature (a block without one starts at it).
+FluidBlock fluid_block_from_json(const Json& f, const std::string& path, const Scene& s,
+                                 const Json& materials) {
+  FluidBlock block;
+  block.material = material_index(materials, f["material"], path + ".material", "fluid", "a fluid block");
+  block.box = box(f["box"]);
+  block.velocity = vec(f["velocity"]);
+  block.temperature = temperature_or(f, s.heat.ambient_temperature);
+  check_box(block.box, path + ".box", "empty box");
+  check_inside(s.domain, block.box, path + ".box");
+  check_start(s, block.material, block.temperature, path + (f.contains("temperature") ? ".temperature" : ""));
+  return block;
+}
+
+IceBlock ice_block_from_json(Json& f, const std::string& path, const Scene& s, const Json& materials,
+                             const std::string& folder) {
+  IceBlock block;
+  block.material = material_index(materials, f["material"], path + ".material", "ice", "an ice block");
+  block.shape = shape_of(f, path, folder);
+  block.box = box_of(block.shape);
+  block.motion = f["motion"] == "free" ? IceBlock::Motion::Free : IceBlock::Motion::Fixed;
+  const double melt = s.materials[static_cast<std::size_t>(block.material)].melting_point;
+  block.temperature = temperature_or(f, std::min(s.heat.ambient_temperature, melt));
+  check_inside(s.domain, block.box, block.shape.axis_aligned_box() ? path + ".box" : path);
+  check_start(s, block.material, block.temperature, path + ".temperature");
+  return block;
+}
+
+// A solid as its file says it; a held one's material variant is the loader's business.
+Solid solid_from_json(Json& j, const std::string& path, const Scene& s, const Json& materials,
+                      const std::string& folder) {
+  Solid solid;
+  solid.material = material_index(materials, j["material"], path + ".material", "solid", "a solid");
+  if (j["shape"] != "plane") {
+    solid.shape = shape_of(j, path, folder);
+    solid.box = box_of(solid.shape);
+  } else {
+    check_shared_shape_fields(j, path);
+    solid.plane = true;
+    solid.point = vec(j["point"]);
+    solid.normal = unit_direction(vec(j["normal"]), path + ".normal");
+  }
+  solid.temperature = temperature_or(j, s.heat.ambient_temperature);
+  return solid;
+}
+
 Scene convert_and_check(Json doc, const std::string& folder) {
   Scene s;
   s.name = doc["name"].get<std::string>();
@@ -251,17 +342,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   }
 
   const Json& materials = doc["materials"];
-  for (const auto& [name, m] : materials.items()) {
-    Material mat;
-    mat.name = name;
-    mat.kind =
-        choice_of<MaterialKind>(m["kind"], {MaterialKind::Fluid, MaterialKind::Solid, MaterialKind::Ice});
-    mat.density = m["density"].get<double>();
-    mat.viscosity = m["viscosity"].get<double>();
-    mat.conductivity = m["conductivity"].get<double>();
-    mat.specific_heat = m["specific_heat"].get<double>();
-    s.materials.push_back(mat);
-  }
+  for (const auto& [name, m] : materials.items()) s.materials.push_back(material_from_json(name, m));
   // Ice and the fluid it melts into share the latent heat and melting point (sim/kernels/thermal_law.h).
   {
     int index = 0;
@@ -283,28 +364,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
       ++index;
     }
   }
-  s.heat.enabled = doc["heat"]["enabled"].get<bool>();
-  s.heat.time_scale = doc["heat"]["time_scale"].get<double>();
-  s.heat.exposed_area = choice_of<ExposedArea>(doc["heat"]["exposed_area"], {ExposedArea::Iwasaki2010});
-  s.heat.ambient_temperature = doc["ambient"]["temperature"].get<double>();
-  s.heat.ambient_coefficient = doc["ambient"]["heat_transfer_coefficient"].get<double>();
-  s.heat.wall_coefficient = domain["wall_heat"]["coefficient"].get<double>();
-  s.heat.wall_temperature = domain["wall_heat"]["temperature"].get<double>();
-  const double ambient = s.heat.ambient_temperature;
-  auto temperature_of = [&](const Json& object, double fallback) {
-    return object.contains("temperature") ? object["temperature"].get<double>() : fallback;
-  };
-  // Phase-changing materials start on their own side of the melting point (no supercooled water here).
-  auto check_start = [&](int material, double T, const std::string& path) {
-    const Material& m = s.materials[static_cast<std::size_t>(material)];
-    if (m.partner < 0) return;
-    if (m.kind == MaterialKind::Ice && T > m.melting_point)
-      throw SceneError(path, format_number(T) + " °C is above the melting point of '" + m.name + "' (" +
-                                 format_number(m.melting_point) + " °C)");
-    if (m.kind == MaterialKind::Fluid && T < m.melting_point)
-      throw SceneError(path, format_number(T) + " °C is below the freezing point of '" + m.name + "' (" +
-                                 format_number(m.melting_point) + " °C); supercooled fluid is not modelled");
-  };
+  s.heat = heat_settings_from_json(doc);
 
   s.walls = domain["walls"].get<std::vector<std::string>>();
   s.wall_layers = domain["wall_layers"].get<int>();
@@ -350,54 +410,17 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     s.wall_material = static_cast<int>(s.materials.size()) - 1;
   }
 
-  for (std::size_t i = 0; i < doc["fluids"].size(); ++i) {
-    const Json& f = doc["fluids"][i];
-    const std::string path = join_path("fluids", i);
-    FluidBlock block;
-    block.material = material_index(materials, f["material"], path + ".material", "fluid", "a fluid block");
-    block.box = box(f["box"]);
-    block.velocity = vec(f["velocity"]);
-    block.temperature = temperature_of(f, ambient);
-    check_box(block.box, path + ".box", "empty box");
-    check_inside(s.domain, block.box, path + ".box");
-    check_start(block.material, block.temperature, path + (f.contains("temperature") ? ".temperature" : ""));
-    s.fluids.push_back(block);
-  }
-
-  for (std::size_t i = 0; i < doc["ice"].size(); ++i) {
-    Json& f = doc["ice"][i];
-    const std::string path = join_path("ice", i);
-    IceBlock block;
-    block.material = material_index(materials, f["material"], path + ".material", "ice", "an ice block");
-    block.shape = shape_of(f, path, folder);
-    block.box = box_of(block.shape);
-    block.motion = f["motion"] == "free" ? IceBlock::Motion::Free : IceBlock::Motion::Fixed;
-    const double melt = s.materials[static_cast<std::size_t>(block.material)].melting_point;
-    block.temperature = temperature_of(f, std::min(ambient, melt));
-    check_inside(s.domain, block.box, block.shape.axis_aligned_box() ? path + ".box" : path);
-    check_start(block.material, block.temperature, path + ".temperature");
-    s.ice.push_back(block);
-  }
+  for (std::size_t i = 0; i < doc["fluids"].size(); ++i)
+    s.fluids.push_back(fluid_block_from_json(doc["fluids"][i], join_path("fluids", i), s, materials));
+  for (std::size_t i = 0; i < doc["ice"].size(); ++i)
+    s.ice.push_back(ice_block_from_json(doc["ice"][i], join_path("ice", i), s, materials, folder));
   if (s.fluids.empty() && s.ice.empty() && doc["emitters"].empty())
     throw SceneError("fluids",
                      "the scene has neither fluid nor ice nor an emitter: add a block to fluids or ice");
 
   for (std::size_t i = 0; i < doc["solids"].size(); ++i) {
     Json& j = doc["solids"][i];
-    const std::string path = join_path("solids", i);
-    Solid solid;
-    solid.material = material_index(materials, j["material"], path + ".material", "solid", "a solid");
-    if (j["shape"] != "plane") {
-      solid.shape = shape_of(j, path, folder);
-      solid.box = box_of(solid.shape);
-    } else {
-      check_shared_shape_fields(j, path);
-      solid.plane = true;
-      solid.point = vec(j["point"]);
-      solid.normal = vec(j["normal"]);
-      solid.normal = unit_direction(solid.normal, path + ".normal");
-    }
-    solid.temperature = temperature_of(j, ambient);
+    Solid solid = solid_from_json(j, join_path("solids", i), s, materials, folder);
     if (j["hold_temperature"].get<bool>()) {
       Material held = s.materials[static_cast<std::size_t>(solid.material)];
       held.name += " (held at " + format_number(solid.temperature) + " °C)";
@@ -417,7 +440,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     s.dryers.push_back(dryer_from_json(doc["dryers"][i], join_path("dryers", i)));
   for (std::size_t i = 0; i < doc["emitters"].size(); ++i) {
     Json e = doc["emitters"][i];
-    if (!e.contains("temperature")) e["temperature"] = ambient;
+    if (!e.contains("temperature")) e["temperature"] = s.heat.ambient_temperature;
     const std::string path = join_path("emitters", i);
     s.emitters.push_back(emitter_from_json(e, path, s.materials));
     check_emitter(s.emitters.back(), s, path);
