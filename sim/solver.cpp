@@ -384,18 +384,20 @@ void Solver::remove_particles_from(std::size_t kept) {
 }
 
 void Solver::emit(double dt) {
+  // What the emitters and the ids were before this step's particles, should they not fit.
+  const std::vector<double> before = emitters_->save({next_id_, layout_.capacity});
+  const std::uint32_t first_id = next_id_;
   HostParticles in = emitters_->emit(time_ - dt, dt, next_id_);
   if (in.size() == 0) return;
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    const double mass = double(in.position[i][3]) * table_[in.material[i]].thermal_mass_scale;
-    budget_.inflow += mass * (double(in.enthalpy[i][0]) + double(in.enthalpy[i][1]));
-  }
   if (n_ + in.size() > layout_.capacity) {
     // Out of room: rebuild every stage for half as many again (at least what is needed) from the state,
     // as a resumed run would; a run resumed from a state file written before this point grows here too.
     const std::size_t grown = std::max(n_ + in.size(), layout_.capacity + layout_.capacity / 2);
     const double needed = estimated_memory_bytes(double(grown)), limit = memory_limit_bytes();
     if (needed > limit) {
+      // Nothing came in: the books and ids stay with the particles there are.
+      emitters_->restore(before);
+      next_id_ = first_id;
       std::ostringstream os;
       os << "step " << steps_ << " (t = " << time_ << " s): the emitters have filled the run to " << n_
          << " particles, and " << grown << " would need about " << needed / 1e9 << " GB, more than the "
@@ -404,6 +406,10 @@ void Solver::emit(double dt) {
       throw BlowUpError(os.str());
     }
     build(state(), grown);
+  }
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const double mass = double(in.position[i][3]) * table_[in.material[i]].thermal_mass_scale;
+    budget_.inflow += mass * (double(in.enthalpy[i][0]) + double(in.enthalpy[i][1]));
   }
   if (!heat_) {
     fixed_enthalpy_.resize(next_id_, Float2{0.f, 0.f});

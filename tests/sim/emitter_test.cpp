@@ -246,6 +246,60 @@ TEST_F(EmitterTest, ATapOpensAndClosesBetweenSteps) {
   EXPECT_THROW(s.set_emitter(3, e), Error);
 }
 
+// A source pushed to its limits: the fastest jet the schema allows (50 m/s) out of a wide nozzle, into
+// a tank open at the top, so the splash leaves. The sound speed follows the jet, so the step shrinks and
+// the run goes on: no NaN, nothing lost or clamped, the books close.
+TEST_F(EmitterTest, TheFastestJetRunsWithoutLosingAParticle) {
+  const Scene scene = tank_scene(
+      R"({"material": "water", "position": [0.03, 0.03, 0.1], "radius": 0.02, "speed": 50, "temperature": 60})",
+      {R"(domain.open=["+z"])"});
+  Solver s(cl(), scene, initial_state(scene));
+  while (s.inflow().particles < 2000 && s.steps() < 3000) s.step();
+  ASSERT_GE(s.inflow().particles, 2000u) << "in " << s.steps() << " steps";
+  const HostParticles p = s.particles();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_TRUE(std::isfinite(p.position[i][c])) << "particle " << p.id[i];
+      ASSERT_TRUE(std::isfinite(p.velocity[i][c])) << "particle " << p.id[i];
+    }
+  const Metrics m = measure(s);
+  EXPECT_EQ(s.size() + s.outflow().particles, initial_state(scene).particles.size() + s.inflow().particles);
+  EXPECT_EQ(s.clamped(), 0u);
+  EXPECT_NEAR(m.fluid_mass + s.outflow().mass, s.inflow().mass, 1e-9 * s.inflow().mass);
+  EXPECT_LT(std::abs(m.closure()), 1e-9 * m.enthalpy_scale) << "closure " << m.closure() << " J";
+}
+
+// A tap left open in a closed tank fills it until the memory runs out: the run stops with an error that
+// says how many particles it has, what more would need and what to do, before allocating anything.
+TEST_F(EmitterTest, ATapThatWouldOutgrowTheMemoryStopsTheRunSayingWhy) {
+  struct Restore {
+    bool had = std::getenv("THAW_MEMORY_LIMIT") != nullptr;
+    std::string old = had ? std::getenv("THAW_MEMORY_LIMIT") : "";
+    ~Restore() { had ? ::setenv("THAW_MEMORY_LIMIT", old.c_str(), 1) : ::unsetenv("THAW_MEMORY_LIMIT"); }
+  } restore;
+  const Scene scene =
+      tank_scene(R"({"material": "water", "position": [0.03, 0.03, 0.1], "radius": 0.012, "speed": 1})");
+  SimState start = initial_state(scene);
+  const std::size_t n0 = start.particles.size();
+  start.inflow = {0, 0, 0, 0, 0, double(n0), double(n0 + 200), 0};  // room for 200 more
+  Solver s(cl(), scene, start);
+  // Room for what the solver holds now, not for half as many again.
+  const std::string limit = std::to_string(estimated_memory_bytes(double(s.capacity())) + 1.0);
+  ::setenv("THAW_MEMORY_LIMIT", limit.c_str(), 1);
+  try {
+    for (int i = 0; i < 100000; ++i) s.step();
+    FAIL() << "the tank held " << s.size() << " particles within the limit";
+  } catch (const BlowUpError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the emitters have filled the run to"), std::string::npos) << what;
+    EXPECT_NE(what.find("THAW_MEMORY_LIMIT"), std::string::npos) << what;
+    EXPECT_NE(what.find("emitters[].open"), std::string::npos) << what;
+  }
+  EXPECT_LE(s.size(), s.capacity()) << "nothing was written past the buffers";
+  EXPECT_NEAR(measure(s).fluid_mass, s.inflow().mass, 1e-9 * s.inflow().mass)
+      << "the books hold what came in, not what was refused";
+}
+
 TEST(EmitterScene, MistakesNameTheField) {
   struct Bad {
     std::string emitter, path, says;
