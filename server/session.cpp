@@ -49,6 +49,12 @@ void answer(const Session::Done& done, std::optional<ErrorCode> code, const std:
   }
 }
 
+// Why a dryer, lamp or emitter index is not one of the scene's; empty when it is.
+std::string missing(const std::string& what, int index, std::size_t count) {
+  if (index >= 0 && std::size_t(index) < count) return "";
+  return what + " " + std::to_string(index) + " does not exist; the scene has " + std::to_string(count);
+}
+
 double ice_mass_of(const HostParticles& p, const Scene& scene, double rest_density) {
   return measure(p, scene, rest_density).ice_mass;
 }
@@ -416,6 +422,19 @@ Session::Outcome Session::apply(const protocol::Command& command, Done& done, bo
       command);
 }
 
+Json Session::adopt(const std::string& array, int index, const Json& fields) {
+  Json& source = scene_.source[array][std::size_t(index)];
+  for (const auto& [key, value] : fields.items()) source[key] = value;
+  {
+    std::lock_guard lock(publish_mutex_);
+    scene_published_ = std::make_shared<const Scene>(scene_);
+  }
+  dirty_ = true;
+  Json result = fields;
+  result[array.substr(0, array.size() - 1)] = index;  // "dryer": 0
+  return result;
+}
+
 Session::Outcome Session::set_dryer(int index, const Dryer& d) {
   try {
     solver_->set_dryer(std::size_t(index), d);
@@ -424,25 +443,12 @@ Session::Outcome Session::set_dryer(int index, const Dryer& d) {
   }
   const Dryer& now = solver_->dryers()[std::size_t(index)];
   scene_.dryers[std::size_t(index)] = now;
-  const Json fields = to_json(now);
-  Json& source = scene_.source["dryers"][std::size_t(index)];
-  for (const auto& [key, value] : fields.items()) source[key] = value;
-  {
-    std::lock_guard lock(publish_mutex_);
-    scene_published_ = std::make_shared<const Scene>(scene_);
-  }
-  dirty_ = true;
-  Json result = fields;
-  result["dryer"] = index;
-  return {std::nullopt, "", result};
+  return {std::nullopt, "", adopt("dryers", index, to_json(now))};
 }
 
 Session::Outcome Session::apply(const protocol::DryerSet& c) {
-  const std::size_t count = solver_->dryers().size();
-  if (c.dryer < 0 || std::size_t(c.dryer) >= count)
-    return {ErrorCode::NotFound,
-            "dryer " + std::to_string(c.dryer) + " does not exist; the scene has " + std::to_string(count),
-            {}};
+  if (std::string m = missing("dryer", c.dryer, solver_->dryers().size()); !m.empty())
+    return {ErrorCode::NotFound, m, {}};
   Dryer d = solver_->dryers()[std::size_t(c.dryer)];
   if (c.on) d.on = *c.on;
   if (c.position) d.position = *c.position;
@@ -455,11 +461,8 @@ Session::Outcome Session::apply(const protocol::DryerSet& c) {
 }
 
 Session::Outcome Session::aim(const Aim& a) {
-  const std::size_t count = solver_->dryers().size();
-  if (a.dryer < 0 || std::size_t(a.dryer) >= count)
-    return {ErrorCode::NotFound,
-            "dryer " + std::to_string(a.dryer) + " does not exist; the scene has " + std::to_string(count),
-            {}};
+  if (std::string m = missing("dryer", a.dryer, solver_->dryers().size()); !m.empty())
+    return {ErrorCode::NotFound, m, {}};
   Dryer d = solver_->dryers()[std::size_t(a.dryer)];
   const Eigen::Vector3d toward = a.hit - d.position;
   if (!a.hit.allFinite() || toward.norm() < 1e-9)
@@ -469,11 +472,8 @@ Session::Outcome Session::aim(const Aim& a) {
 }
 
 Session::Outcome Session::apply(const protocol::LampSet& c) {
-  const std::size_t count = solver_->lamps().size();
-  if (c.lamp < 0 || std::size_t(c.lamp) >= count)
-    return {ErrorCode::NotFound,
-            "lamp " + std::to_string(c.lamp) + " does not exist; the scene has " + std::to_string(count),
-            {}};
+  if (std::string m = missing("lamp", c.lamp, solver_->lamps().size()); !m.empty())
+    return {ErrorCode::NotFound, m, {}};
   Lamp l = solver_->lamps()[std::size_t(c.lamp)];
   if (c.on) l.on = *c.on;
   if (c.centre) l.centre = *c.centre;
@@ -491,26 +491,12 @@ Session::Outcome Session::set_lamp(int index, const Lamp& l) {
   }
   const Lamp& now = solver_->lamps()[std::size_t(index)];
   scene_.lamps[std::size_t(index)] = now;
-  const Json fields = to_json(now);
-  Json& source = scene_.source["lamps"][std::size_t(index)];
-  for (const auto& [key, value] : fields.items()) source[key] = value;
-  {
-    std::lock_guard lock(publish_mutex_);
-    scene_published_ = std::make_shared<const Scene>(scene_);
-  }
-  dirty_ = true;
-  Json result = fields;
-  result["lamp"] = index;
-  return {std::nullopt, "", result};
+  return {std::nullopt, "", adopt("lamps", index, to_json(now))};
 }
 
 Session::Outcome Session::apply(const protocol::EmitterSet& c) {
-  const std::size_t count = solver_->emitters().size();
-  if (c.emitter < 0 || std::size_t(c.emitter) >= count)
-    return {
-        ErrorCode::NotFound,
-        "emitter " + std::to_string(c.emitter) + " does not exist; the scene has " + std::to_string(count),
-        {}};
+  if (std::string m = missing("emitter", c.emitter, solver_->emitters().size()); !m.empty())
+    return {ErrorCode::NotFound, m, {}};
   Emitter e = solver_->emitters()[std::size_t(c.emitter)];
   if (c.open) e.open = *c.open;
   if (c.position) e.position = *c.position;
@@ -540,17 +526,8 @@ Session::Outcome Session::set_emitter(int index, const Emitter& e) {
   }
   const Emitter& now = solver_->emitters()[i];
   scene_.emitters[i] = now;
-  Json fields = to_json(now, scene_.materials);
-  Json& source = scene_.source["emitters"][i];
-  source.erase("rate");  // the exit speed says it now
-  for (const auto& [key, value] : fields.items()) source[key] = value;
-  {
-    std::lock_guard lock(publish_mutex_);
-    scene_published_ = std::make_shared<const Scene>(scene_);
-  }
-  dirty_ = true;
-  Json result = fields;
-  result["emitter"] = index;
+  scene_.source["emitters"][i].erase("rate");  // the exit speed says it now
+  Json result = adopt("emitters", index, to_json(now, scene_.materials));
   result["rate"] = now.volume_flow() * 1e3;
   result["applied"] = applied;
   return {std::nullopt, "", result};

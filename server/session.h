@@ -143,6 +143,9 @@ class Session {
   // as they are (a temperature the run has no heat stage for, a jet faster than its sound speed allows);
   // the result says which ("applied").
   Outcome set_emitter(int index, const Emitter& e);
+  // After a live change to scene_.ARRAY[index] (dryers, lamps, emitters): its `fields` into the scene
+  // document, the scene republished; returns the fields with the index under the singular ("dryer").
+  Json adopt(const std::string& array, int index, const Json& fields);
 
   void step_once();
   void rebuild(Scene scene, const SimState& state, bool fresh_start);

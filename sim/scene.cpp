@@ -513,8 +513,11 @@ std::string parse_reason(const std::string& what) {
 
 }  // namespace
 
+namespace {
+Json v(const Eigen::Vector3d& x) { return Json::array({x.x(), x.y(), x.z()}); }
+}  // namespace
+
 Json to_json(const Dryer& d) {
-  const auto v = [](const Eigen::Vector3d& x) { return Json::array({x.x(), x.y(), x.z()}); };
   return {{"on", d.on},
           {"position", v(d.position)},
           {"direction", v(d.direction)},
@@ -526,7 +529,6 @@ Json to_json(const Dryer& d) {
 }
 
 Json to_json(const Lamp& l) {
-  const auto v = [](const Eigen::Vector3d& x) { return Json::array({x.x(), x.y(), x.z()}); };
   return {{"on", l.on},
           {"centre", v(l.centre)},
           {"normal", v(l.normal)},
@@ -566,7 +568,6 @@ Lamp lamp_from_json(const Json& j, const std::string& path) {
 double Emitter::area() const { return M_PI * radius * radius; }
 
 Json to_json(const Emitter& e, const std::vector<Material>& materials) {
-  const auto v = [](const Eigen::Vector3d& x) { return Json::array({x.x(), x.y(), x.z()}); };
   return {{"open", e.open},
           {"material", materials.at(static_cast<std::size_t>(e.material)).name},
           {"position", v(e.position)},
