@@ -22,11 +22,10 @@ int cmd_render(int argc, char** argv) {
   if (args.positional().size() != 1) throw Error("render takes one state file (from thaw run --state-out)");
   const auto out = args.value("--out");
   if (!out) throw Error("render needs --out FILE.png");
-  const RenderOptions o = render_options(args);
-
   const SimState state = read_state_file(args.positional()[0]);
   const Scene scene = scene_from_json(parse_json(state.scene_json));
   check_state(state, scene, args.positional()[0]);
+  const RenderOptions o = render_options(args, scene.camera);
   const RenderSnapshot snap =
       make_snapshot(state.particles, temperatures_of(state.particles, scene), scene, state.time, state.step);
 

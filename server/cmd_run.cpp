@@ -91,7 +91,7 @@ int cmd_run(int argc, char** argv) {
   std::unique_ptr<ParticleExporter> exporter;
   if (auto d = args.value("--export")) exporter = std::make_unique<ParticleExporter>(*d);
   // Frames (PNG, off-screen) and meshes share the snapshot of a step.
-  const RenderOptions render = render_options(args);
+  const RenderOptions render = render_options(args, scene.camera);
   const auto frames_dir = args.value("--frames");
   std::unique_ptr<FrameRenderer> renderer;
   if (frames_dir) {

@@ -64,9 +64,9 @@ int cmd_serve(int argc, char** argv) {
   Session session(*cl, scene, args.sets(), args.value("--state-dir").value_or("thaw-states"));
   session.set_thread_nice(kSimulationNice);
   std::atomic<Service*> service_ptr{nullptr};
-  // Looking down at 50 degrees shows what lies inside a glass or a tank, which the melting scenes have.
+  // The scene's own camera (its `camera` block); on every scene change the service puts it back.
   RenderOptions view;
-  view.elevation = 50.0;
+  use_camera(view, session.scene()->camera);
   // Fast surfaces keep the stream at 10+ frames a second on 2 cores (docs/RENDERING.md); a client can
   // ask for full quality with quality.set.
   view.quality = "fast";

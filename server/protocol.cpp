@@ -125,7 +125,8 @@ Field index_field(const std::string& key, const std::string& what) {
 constexpr const char* kTypeNames[] = {"hello",      "dryer.set",  "dryer.aim",    "lamp.set",   "sim.pause",
                                       "sim.resume", "sim.step",   "sim.reset",    "sim.speed",  "scene.load",
                                       "param.set",  "camera.set", "camera.orbit", "view.set",   "quality.set",
-                                      "state.save", "state.load", "frame.ack",    "emitter.set"};
+                                      "state.save", "state.load", "frame.ack",    "emitter.set",
+                                      "camera.reset"};
 static_assert(std::size(kTypeNames) == std::variant_size_v<Command>, "one name per command");
 
 // ---- the commands, one row each -------------------------------------------------------------------------
@@ -385,6 +386,7 @@ std::vector<Spec> build_specs() {
                        live("emitters[0].radius"), live("emitters[0].speed"), live("emitters[0].rate"),
                        live("emitters[0].temperature"), live("emitters[0].start"), live("emitters[0].stop")},
                       read_emitter_set));
+  rows.push_back(row<CameraReset>("camera.reset", {}));
 
   // Rows in variant order, so type_name and needs_controller index them by Command::index().
   std::vector<Spec> ordered(std::variant_size_v<Command>);
@@ -393,7 +395,8 @@ std::vector<Spec> build_specs() {
       index_of<SimPause>(),    index_of<SimResume>(), index_of<SimStep>(),    index_of<SimReset>(),
       index_of<SimSpeed>(),    index_of<SceneLoad>(), index_of<ParamSet>(),   index_of<CameraSet>(),
       index_of<CameraOrbit>(), index_of<ViewSet>(),   index_of<QualitySet>(), index_of<StateSave>(),
-      index_of<StateLoad>(),   index_of<FrameAck>(),  index_of<EmitterSet>()};
+      index_of<StateLoad>(),   index_of<FrameAck>(),  index_of<EmitterSet>(),
+      index_of<CameraReset>()};
   static_assert(std::size(indices) == std::variant_size_v<Command>, "one row per command");
   for (std::size_t i = 0; i < rows.size(); ++i) ordered[indices[i]] = std::move(rows[i]);
   for (std::size_t i = 0; i < ordered.size(); ++i) {
@@ -528,7 +531,8 @@ bool needs_controller(const Command& c) {
   // cost of the one frame every client shares: a viewer asking for 1920x1080 at full quality and 60
   // frames a second cut everyone to under 1 frame a second and the simulation from 50 to 4-40 steps/s.
   return !(std::holds_alternative<Hello>(c) || std::holds_alternative<CameraSet>(c) ||
-           std::holds_alternative<CameraOrbit>(c) || std::holds_alternative<ViewSet>(c) ||
+           std::holds_alternative<CameraOrbit>(c) || std::holds_alternative<CameraReset>(c) ||
+           std::holds_alternative<ViewSet>(c) ||
            std::holds_alternative<FrameAck>(c));
 }
 

@@ -81,6 +81,7 @@ struct CameraSet {
 struct CameraOrbit {                                // relative change, e.g. from a mouse drag or wheel
   double d_azimuth = 0, d_elevation = 0, zoom = 1;  // deg, deg, distance factor
 };
+struct CameraReset {};  // back to the scene's own camera
 struct ViewSet {
   std::string view = "surface";          // surface | particles | slice
   std::optional<std::string> colour_by;  // phase | temperature
@@ -103,7 +104,7 @@ struct FrameAck {
 
 using Command = std::variant<Hello, DryerSet, DryerAim, LampSet, SimPause, SimResume, SimStep, SimReset,
                              SimSpeed, SceneLoad, ParamSet, CameraSet, CameraOrbit, ViewSet, QualitySet,
-                             StateSave, StateLoad, FrameAck, EmitterSet>;
+                             StateSave, StateLoad, FrameAck, EmitterSet, CameraReset>;
 
 // The `type` string of each command, e.g. "dryer.set".
 const char* type_name(const Command& c);

@@ -33,8 +33,18 @@ std::vector<double> numbers(const std::string& option, const std::string& text, 
 
 }  // namespace
 
-RenderOptions render_options(const CliArgs& args) {
+void use_camera(RenderOptions& o, const SceneCamera& camera) {
+  o.azimuth = camera.azimuth;
+  o.elevation = camera.elevation;
+  o.distance = camera.distance;
+  o.fov = camera.fov;
+  o.has_target = camera.target.has_value();
+  o.target = camera.target.value_or(Eigen::Vector3d::Zero());
+}
+
+RenderOptions render_options(const CliArgs& args, const SceneCamera& camera) {
   RenderOptions o;
+  use_camera(o, camera);
   if (auto v = args.value("--view")) {
     if (*v != "surface" && *v != "particles" && *v != "slice")
       throw Error("--view: unknown view '" + *v + "'; available: surface, particles, slice");

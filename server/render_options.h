@@ -11,6 +11,7 @@
 #include "render/snapshot.h"
 #include "render/surface_renderer.h"
 #include "server/cli_args.h"
+#include "sim/scene.h"
 
 namespace thaw {
 
@@ -35,8 +36,12 @@ inline const char* const kRenderValueOptions[] = {"--size",  "--camera",      "-
                                                   "--fov",   "--view",        "--colour-by",
                                                   "--slice", "--field-cells", "--quality"};
 
-// Reads the options; a malformed value is an Error naming the option and what was expected.
-RenderOptions render_options(const CliArgs& args);
+// Puts the scene's camera (its `camera` block) into the options.
+void use_camera(RenderOptions& o, const SceneCamera& camera);
+
+// Reads the options, starting from the scene's camera; a malformed value is an Error naming the option and
+// what was expected.
+RenderOptions render_options(const CliArgs& args, const SceneCamera& camera);
 
 // How close and how far the camera may go, in multiples of the distance that frames the domain.
 inline constexpr double kClosest = 0.05, kFarthest = 8.0;

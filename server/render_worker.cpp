@@ -233,6 +233,15 @@ void RenderWorker::set_camera(std::optional<double> azimuth, std::optional<doubl
   cv_.notify_all();
 }
 
+void RenderWorker::reset_camera(const SceneCamera& camera) {
+  {
+    std::lock_guard lock(mutex_);
+    use_camera(options_, camera);
+    ++options_version_;
+  }
+  cv_.notify_all();
+}
+
 void RenderWorker::orbit(double d_azimuth, double d_elevation, double zoom) {
   if (!std::isfinite(d_azimuth) || !std::isfinite(d_elevation) || !(zoom > 0 && std::isfinite(zoom)))
     throw Error("camera.orbit: angles must be finite and zoom positive");

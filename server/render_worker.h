@@ -58,6 +58,8 @@ class RenderWorker {
   void set_camera(std::optional<double> azimuth, std::optional<double> elevation,
                   std::optional<double> distance, std::optional<Eigen::Vector3d> target,
                   std::optional<double> fov);
+  // Back to a scene's own camera (its `camera` block): on scene changes and camera.reset.
+  void reset_camera(const SceneCamera& camera);
   // Relative: degrees added to azimuth and elevation (clamped to +-89), distance multiplied by zoom.
   void orbit(double d_azimuth, double d_elevation, double zoom);
   // view: surface | particles | slice; colour_by: phase | temperature.

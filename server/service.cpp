@@ -28,6 +28,17 @@ Json scene_names() {
 
 Json vec(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
+Json view_json(const RenderOptions& o) { return {{"view", o.view}, {"colour_by", o.colour_by}}; }
+
+// The camera as drawn now: distance 0 frames the domain, target null looks at its centre.
+Json camera_json(const RenderOptions& o) {
+  return {{"azimuth", o.azimuth},
+          {"elevation", o.elevation},
+          {"distance", o.distance},
+          {"target", o.has_target ? vec(o.target) : Json(nullptr)},
+          {"fov", o.fov}};
+}
+
 Json dryers_json(const Scene& s) {
   Json out = Json::array();
   for (const Dryer& d : s.dryers) out.push_back(to_json(d));
@@ -49,6 +60,7 @@ Json emitters_json(const Scene& s) {
 
 Service::Service(Session& session, RenderWorker& renderer, ServiceOptions options)
     : session_(session), renderer_(renderer), options_(std::move(options)) {
+  if (const auto stats = session_.latest_stats()) generation_ = stats->value("generation", std::uint64_t(0));
   subscription_ = session_.subscribe([this] { on_published(); });
   // Nobody connected: no frames to draw, so the simulation gets the whole machine.
   renderer_.set_watched(false);
@@ -58,26 +70,48 @@ Service::~Service() { session_.unsubscribe(subscription_); }
 
 void Service::attach(WsServer& server) { server_ = &server; }
 
-Json Service::welcome(bool controller) const {
+Json Service::scene_state() const {
   const auto scene = session_.scene();
+  const auto stats = session_.latest_stats();
+  const RenderOptions o = renderer_.options();
   Json lamps = Json::array();
-  for (const Lamp& l : scene->lamps)
-    lamps.push_back(
-        {{"on", l.on}, {"centre", vec(l.centre)}, {"normal", vec(l.normal)}, {"temperature", l.temperature}});
-  return {{"type", "welcome"},
-          {"protocol", protocol::kVersion},
-          {"scene", scene->name},
-          {"scenes", scene_names()},
+  for (const Lamp& l : scene->lamps) lamps.push_back(to_json(l));
+  return {{"scene", scene->name},
+          {"description", scene->description},
           {"dryers", dryers_json(*scene)},
-          {"emitters", emitters_json(*scene)},
           {"lamps", lamps},
-          {"role", controller ? "controller" : "viewer"},
-          {"views", {"surface", "particles", "slice"}},
-          {"limits",
-           {{"max_message_bytes", protocol::kMaxMessageBytes},
-            {"commands_per_second", options_.command_rate},
-            {"command_burst", options_.command_burst},
-            {"unacknowledged_frames", 2}}}};
+          {"emitters", emitters_json(*scene)},
+          {"view", view_json(o)},
+          {"quality", quality_json()},
+          {"camera", camera_json(o)},
+          {"speed", stats ? stats->value("speed", 0.0) : 0.0},
+          {"heat_time_scale", scene->heat.time_scale},
+          {"paused", stats ? stats->value("paused", false) : false}};
+}
+
+Json Service::quality_json() const {
+  const RenderOptions now = renderer_.options();
+  return {{"width", now.width},
+          {"height", now.height},
+          {"jpeg_quality", renderer_.jpeg_quality()},
+          {"fps", renderer_.fps_cap()},
+          {"fps_limit", renderer_.fps_limit()},
+          {"surface", now.quality}};
+}
+
+Json Service::welcome(bool controller) const {
+  Json w = {{"type", "welcome"},
+            {"protocol", protocol::kVersion},
+            {"scenes", scene_names()},
+            {"role", controller ? "controller" : "viewer"},
+            {"views", {"surface", "particles", "slice"}},
+            {"limits",
+             {{"max_message_bytes", protocol::kMaxMessageBytes},
+              {"commands_per_second", options_.command_rate},
+              {"command_burst", options_.command_burst},
+              {"unacknowledged_frames", 2}}}};
+  w.update(scene_state());
+  return w;
 }
 
 void Service::reply(std::uint64_t client, const Json& event) {
@@ -189,19 +223,15 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
         } else if constexpr (std::is_same_v<T, CameraOrbit>) {
           renderer_.orbit(c.d_azimuth, c.d_elevation, c.zoom);
           done({}, "", Json::object());
+        } else if constexpr (std::is_same_v<T, CameraReset>) {
+          renderer_.reset_camera(session_.scene()->camera);
+          done({}, "", {{"camera", camera_json(renderer_.options())}});
         } else if constexpr (std::is_same_v<T, ViewSet>) {
           renderer_.set_view(c.view, c.colour_by);
           done({}, "", Json::object());
         } else if constexpr (std::is_same_v<T, QualitySet>) {
           renderer_.set_quality(c.width, c.height, c.jpeg_quality, c.fps, c.surface);
-          const RenderOptions now = renderer_.options();
-          done({}, "",
-               {{"width", now.width},
-                {"height", now.height},
-                {"jpeg_quality", renderer_.jpeg_quality()},
-                {"fps", renderer_.fps_cap()},
-                {"fps_limit", renderer_.fps_limit()},
-                {"surface", now.quality}});
+          done({}, "", quality_json());
         } else if constexpr (std::is_same_v<T, DryerAim>) {
           const auto hit = renderer_.pick(c.x, c.y);
           if (!hit)
@@ -218,6 +248,23 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
 }
 
 void Service::on_published() {
+  // A scene loaded, reset or replaced by a saved state: the camera goes back to the scene's own, and
+  // every client gets everything it shows again (the `scene` event), ahead of the stats.
+  if (const auto stats = session_.latest_stats(); stats && server_) {
+    const std::uint64_t generation = stats->value("generation", std::uint64_t(0));
+    bool changed = false;
+    {
+      std::lock_guard lock(mutex_);
+      changed = generation != generation_;
+      generation_ = generation;
+    }
+    if (changed) {
+      renderer_.reset_camera(session_.scene()->camera);
+      Json event = {{"type", "scene"}};
+      event.update(scene_state());
+      server_->broadcast_text(event.dump());
+    }
+  }
   // Stats at most stats_rate a second: a browser needs no more, and they share the socket with frames.
   {
     std::lock_guard lock(mutex_);
@@ -237,6 +284,12 @@ void Service::on_published() {
   const auto scene = session_.scene();
   s["dryers"] = dryers_json(*scene);
   s["emitters"] = emitters_json(*scene);
+  Json lamps = Json::array();
+  for (const Lamp& l : scene->lamps) lamps.push_back(to_json(l));
+  s["lamps"] = std::move(lamps);
+  const RenderOptions o = renderer_.options();
+  s["view"] = view_json(o);
+  s["quality"] = {{"surface", o.quality}, {"width", o.width}, {"height", o.height}};
   server_->broadcast_text(s.dump());
 }
 

@@ -38,8 +38,13 @@ class Service : public WsHandler {
   void on_binary(std::uint64_t client, std::size_t bytes) override;
   void on_close(std::uint64_t client) override;
 
-  // The welcome event a client gets in answer to hello (also for tests and `thaw ctl`).
+  // The welcome event a client gets in answer to hello (also for tests and `thaw ctl`): the protocol, the
+  // scenes, the client's role and limits, and the scene state.
   Json welcome(bool controller) const;
+  // Everything a page shows of the running scene: its name and description, dryers, lamps, emitters, the
+  // view, quality and camera, the simulation speed, the heat time scale and whether it is paused. Sent in
+  // welcome and, as the `scene` event, to every client when the scene is loaded, reset or replaced.
+  Json scene_state() const;
 
   // The render worker's frame callback: sends the newest encoded frame to the loop (any thread).
   void frame_ready();
@@ -51,6 +56,7 @@ class Service : public WsHandler {
   };
   void reply(std::uint64_t client, const Json& event);
   void on_published();
+  Json quality_json() const;  // the frame settings in force (quality.set's answer)
 
   Session& session_;
   RenderWorker& renderer_;
@@ -59,6 +65,7 @@ class Service : public WsHandler {
   std::mutex mutex_;  // clients_ and the stats throttle
   std::map<std::uint64_t, Client> clients_;
   double last_stats_ = -1;
+  std::uint64_t generation_ = 0;  // of the last scene event sent (Session's stats "generation")
   std::uint64_t last_frame_sent_ = 0;
   int subscription_ = 0;
 };

@@ -654,6 +654,7 @@ void Session::rebuild(Scene scene, const SimState& state, bool fresh_start) {
   solver_ = std::move(solver);
   scene_ = std::move(scene);
   if (fresh_start) {
+    ++generation_;
     fail_step_requests("interrupted: the simulation was reset or replaced");
     start_ice_mass_ = ice_mass_of(state.particles, scene_, solver_->constants().rest_density);
   }
@@ -722,7 +723,9 @@ void Session::publish() {
   if (window_steps > 0) last_step_ms_ = 1e3 * window_step_seconds_ / double(window_steps);
 
   std::shared_ptr<const RenderSnapshot> snapshot;
-  Json stats = {{"type", "stats"}, {"scene", scene_.name}, {"time", solver_->time()}, {"steps", steps}};
+  Json stats = {{"type", "stats"},          {"scene", scene_.name},
+                {"time", solver_->time()},  {"steps", steps},
+                {"generation", generation_}, {"heat_time_scale", scene_.heat.time_scale}};
   try {
     // One read of the device serves the picture and the numbers.
     const HostParticles p = solver_->particles();

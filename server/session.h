@@ -83,7 +83,9 @@ class Session {
   // step_ms (wall, over the last publish interval), speed (0: unlimited), particles {water, ice, solid,
   // air}, ice_mass and water_mass [kg], ice_fraction (of the scene's start; null without ice), with heat
   // temperature {min, mean, max} [°C] over ice and water and energy {heat_in, closure [J],
-  // closure_relative}, paused, and error (the step failure that paused the run) while there is one}.
+  // closure_relative}, heat_time_scale, generation (bumped when the scene is loaded, reset or replaced by a
+  // saved state: what a client shows must be rebuilt), paused, and error (the step failure that paused the
+  // run) while there is one}.
   std::shared_ptr<const Json> latest_stats() const;
   std::shared_ptr<const Scene> scene() const;  // the scene as it runs now, live changes included
   std::uint64_t sequence() const;              // bumped by every publish
@@ -193,6 +195,7 @@ class Session {
   std::shared_ptr<const Json> stats_;
   std::shared_ptr<const Scene> scene_published_;
   std::uint64_t sequence_ = 0;
+  std::uint64_t generation_ = 0;  // fresh starts: scene.load, state.load, sim.reset (session thread)
 
   std::mutex listeners_mutex_;
   std::vector<std::pair<int, std::function<void()>>> listeners_;

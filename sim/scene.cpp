@@ -315,6 +315,16 @@ Solid solid_from_json(Json& j, const std::string& path, const Scene& s, const Js
   return solid;
 }
 
+SceneCamera camera_from_json(const Json& j) {
+  SceneCamera c;
+  c.azimuth = j["azimuth"].get<double>();
+  c.elevation = j["elevation"].get<double>();
+  c.distance = j["distance"].get<double>();
+  c.fov = j["fov"].get<double>();
+  if (j.contains("target")) c.target = vec(j["target"]);
+  return c;
+}
+
 Scene convert_and_check(Json doc, const std::string& folder) {
   Scene s;
   s.name = doc["name"].get<std::string>();
@@ -365,6 +375,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     }
   }
   s.heat = heat_settings_from_json(doc);
+  s.camera = camera_from_json(doc["camera"]);
 
   s.walls = domain["walls"].get<std::vector<std::string>>();
   s.wall_layers = domain["wall_layers"].get<int>();

@@ -4,6 +4,7 @@
 // error messages with JSON paths, `--set` overrides and docs/SCENES.md.
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -151,6 +152,14 @@ struct SolverSettings {
   double diffusion_number = 0.1;  // dt <= diffusion_number * h^2 / (time_scale * alpha_max)
 };
 
+// How a viewer first sees the scene (the schema's `camera`): an orbit about `target` [m] (the domain's
+// centre when absent) at `azimuth` and `elevation` [deg], `distance` [m] away (0: the distance that frames
+// the domain), with a vertical field of view `fov` [deg].
+struct SceneCamera {
+  double azimuth = 30.0, elevation = 25.0, distance = 0.0, fov = 40.0;
+  std::optional<Eigen::Vector3d> target;
+};
+
 struct Scene {
   std::string name;
   std::string description;
@@ -172,6 +181,7 @@ struct Scene {
   std::vector<Lamp> lamps;
   std::vector<Dryer> dryers;
   std::vector<Emitter> emitters;
+  SceneCamera camera;
   Json source;  // the validated document with every default filled in
 };
 

@@ -254,6 +254,26 @@ const Field& scene_schema() {
               },
               "Heat transfer and phase change (Iwasaki et al. 2010; docs/ARCHITECTURE.md Numerics)."),
           object(
+              "camera",
+              {
+                  number("azimuth", "Angle about the vertical axis, from +x towards +y")
+                      .in("deg")
+                      .def(30.0)
+                      .at_least(-360)
+                      .at_most(360),
+                  number("elevation", "Angle above the horizontal").in("deg").def(25.0).above(-90).below(90),
+                  number("distance", "From the target; 0 = the distance that frames the whole domain")
+                      .in("m")
+                      .def(0.0)
+                      .at_least(0)
+                      .at_most(1e3),
+                  vec3("target", "The point looked at; default the domain's centre").in("m").optional(),
+                  number("fov", "Vertical field of view").in("deg").def(40.0).at_least(5).at_most(120),
+              },
+              "How a viewer first sees the scene: the browser on load and on 'reset view', `thaw run "
+              "--frames` and `thaw render` unless given --camera, --target or --fov. Frame the subject, not "
+              "the whole domain, where the domain is much larger."),
+          object(
               "ambient",
               {
                   number("temperature", "Air around the scene; objects without a temperature start at it")

@@ -42,12 +42,14 @@ class Thaw:
     def __init__(self, ws):
         self.ws = ws
         self.welcome = None
+        self.scene = None  # the newest scene state: the welcome's, then each `scene` event's
         self.latest_stats = None
         self.latest_frame = None  # (header dict, JPEG bytes)
         self._recent_frames = collections.deque(maxlen=8)
         self._next_id = 1
         self._replies = {}
         self._stats_waiters = []
+        self._scene_waiters = []
         self._frame_waiters = []
         self._reader = None
 
@@ -71,8 +73,15 @@ class Thaw:
             kind = event.get("type")
             if kind == "welcome":
                 self.welcome = event
+                self.scene = event
                 if self._welcome_waiter and not self._welcome_waiter.done():
                     self._welcome_waiter.set_result(event)
+            elif kind == "scene":
+                self.scene = event
+                for future in self._scene_waiters:
+                    if not future.done():
+                        future.set_result(event)
+                self._scene_waiters.clear()
             elif kind == "stats":
                 self.latest_stats = event
                 for waiter in list(self._stats_waiters):
@@ -116,6 +125,12 @@ class Thaw:
         """The next stats event for which predicate(stats) holds."""
         future = asyncio.get_running_loop().create_future()
         self._stats_waiters.append((predicate, future))
+        return await asyncio.wait_for(future, timeout)
+
+    async def scene_event(self, timeout=60):
+        """The next `scene` event (after a scene.load, state.load or sim.reset by any client)."""
+        future = asyncio.get_running_loop().create_future()
+        self._scene_waiters.append(future)
         return await asyncio.wait_for(future, timeout)
 
     async def frame(self, timeout=30):

@@ -80,6 +80,7 @@ const std::vector<std::string>& valid_messages() {
       R"({"type":"frame.ack","frame":42})",
       R"({"type":"emitter.set","emitter":0,"open":true,"position":[0.04,0.04,0.09],"direction":[0,1,-2],)"
       R"("radius":0.006,"speed":0.8,"temperature":40,"start":0.5,"stop":3})",
+      R"({"type":"camera.reset"})",
   };
   return messages;
 }
@@ -172,7 +173,7 @@ TEST(ProtocolParse, LampSet) {
 }
 
 TEST(ProtocolParse, EmitterSet) {
-  const EmitterSet e = parsed<EmitterSet>(valid_messages().back());
+  const EmitterSet e = parsed<EmitterSet>(valid_messages()[18]);
   EXPECT_EQ(e.emitter, 0);
   EXPECT_EQ(e.open, true);
   EXPECT_EQ(*e.position, Eigen::Vector3d(0.04, 0.04, 0.09));
@@ -591,7 +592,8 @@ TEST(ProtocolRefuse, FrameAck) {
 
 TEST(ProtocolRoles, NeedsControllerForWhatEveryoneSees) {
   // quality.set sets the cost of the frame every client shares: controller only.
-  const std::vector<std::string> viewer = {"hello", "camera.set", "camera.orbit", "view.set", "frame.ack"};
+  const std::vector<std::string> viewer = {"hello",    "camera.set", "camera.orbit",
+                                           "camera.reset", "view.set", "frame.ack"};
   for (const std::string& text : valid_messages()) {
     const Command c = std::get<Request>(parse(text)).command;
     const bool presentation = std::find(viewer.begin(), viewer.end(), type_name(c)) != viewer.end();

@@ -64,6 +64,48 @@ asyncio.run(main())
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "final.state")) << "--state-out is written on SIGINT";
 }
 
+// What a page shows is the server's state: welcome carries the scene, its dryers, the view, quality and
+// camera; a scene.load by one client sends every client a `scene` event with the new scene's all, the
+// camera back at the scene's own; a client that connects later (a reload) gets the quality in force,
+// and camera.reset puts the scene's camera back.
+TEST(ServeScene, EveryClientIsToldOfASceneChangeWithEverythingThePageShows) {
+  TempDir dir("serve-scene");
+  ServedScene served(dir, "default --set spacing=0.006 --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(R"(import asyncio, json, thaw_client
+URL = f"ws://127.0.0.1:{PORT}/"
+async def main():
+    async with thaw_client.connect(URL) as ctl, thaw_client.connect(URL) as other:
+        w = ctl.welcome
+        print("welcome", w["scene"], len(w["dryers"]), w["camera"]["elevation"], w["view"]["view"],
+              w["quality"]["surface"], w["heat_time_scale"], w["paused"])
+        await ctl.command("camera.orbit", d_azimuth=40, zoom=0.5)
+        await ctl.command("quality.set", surface="full")
+        waiter = asyncio.ensure_future(other.scene_event())
+        await asyncio.sleep(0)
+        await ctl.command("scene.load", name="ice-on-plate")
+        ev = await waiter
+        c = ev["camera"]
+        print("scene event", ev["scene"], len(ev["dryers"]), len(ev["lamps"]), c["azimuth"], c["elevation"],
+              c["distance"], c["target"])
+        print("quality kept", ev["quality"]["surface"], "description", len(ev["description"]) > 20)
+    async with thaw_client.connect(URL) as again:
+        print("reload", again.welcome["scene"], again.welcome["quality"]["surface"])
+        await again.command("camera.orbit", d_azimuth=10)
+        r = await again.command("camera.reset")
+        print("reset", r["camera"]["azimuth"], r["camera"]["elevation"])
+asyncio.run(main())
+)",
+                                            120, &status);
+  EXPECT_EQ(status, 0) << out;
+  for (const char* line : {"welcome default 1 55.0 surface fast 100.0 False",
+                           "scene event ice-on-plate 0 0 30.0 50.0 0.0 None", "quality kept full description True",
+                           "reload ice-on-plate full", "reset 30.0 50.0"})
+    EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
+  EXPECT_TRUE(served.stop()) << served.log();
+}
+
 // `thaw ctl` from a shell: replies as JSON lines, the exit status says whether all were acknowledged.
 TEST(ServeCtl, SendsCommandsAndPrintsTheReplies) {
   TempDir dir("serve-ctl");
