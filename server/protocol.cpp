@@ -122,11 +122,10 @@ Field index_field(const std::string& key, const std::string& what) {
 }
 
 // Names only, free of the scene schema: type_name must work even if building the table failed.
-constexpr const char* kTypeNames[] = {"hello",      "dryer.set",  "dryer.aim",    "lamp.set",   "sim.pause",
-                                      "sim.resume", "sim.step",   "sim.reset",    "sim.speed",  "scene.load",
-                                      "param.set",  "camera.set", "camera.orbit", "view.set",   "quality.set",
-                                      "state.save", "state.load", "frame.ack",    "emitter.set",
-                                      "camera.reset"};
+constexpr const char* kTypeNames[] = {
+    "hello",       "dryer.set",  "dryer.aim",  "lamp.set",  "sim.pause",   "sim.resume",   "sim.step",
+    "sim.reset",   "sim.speed",  "scene.load", "param.set", "camera.set",  "camera.orbit", "view.set",
+    "quality.set", "state.save", "state.load", "frame.ack", "emitter.set", "camera.reset"};
 static_assert(std::size(kTypeNames) == std::variant_size_v<Command>, "one name per command");
 
 // ---- the commands, one row each -------------------------------------------------------------------------
@@ -210,7 +209,14 @@ void read_emitter_set(EmitterSet& c, const Json& v) {
 }
 
 void read_sim_step(SimStep& c, const Json& v) { c.n = v.at("n").get<int>(); }
-void read_sim_speed(SimSpeed& c, const Json& v) { c.factor = v.at("factor").get<double>(); }
+void read_sim_speed(SimSpeed& c, const Json& v) {
+  c.factor = v.at("factor").get<double>();
+  // Below a millisecond a second the pacing's arithmetic runs away (1e-300 was a flat-out run).
+  if (c.factor > 0 && c.factor < 1e-3)
+    throw FieldError{"factor", std::to_string(c.factor) +
+                                   " is out of range: must be 0 (as fast as possible) "
+                                   "or in [0.001, 1000]"};
+}
 void read_scene_load(SceneLoad& c, const Json& v) { c.name = checked_name(v, "name"); }
 void read_state_save(StateSave& c, const Json& v) { c.name = checked_name(v, "name"); }
 void read_state_load(StateLoad& c, const Json& v) { c.name = checked_name(v, "name"); }
@@ -338,8 +344,10 @@ std::vector<Spec> build_specs() {
   rows.push_back(row<SimReset>("sim.reset", {}));
   rows.push_back(
       row<SimSpeed>("sim.speed",
-                    {number("factor", "Simulated time per wall-clock time; 0.001 is a millisecond a second")
-                         .at_least(1e-3)
+                    {number("factor",
+                            "Simulated time per wall-clock time; 0.001 is a millisecond a second, 0 as fast "
+                            "as possible")
+                         .at_least(0)
                          .at_most(1000)},
                     read_sim_speed));
   rows.push_back(
@@ -395,8 +403,7 @@ std::vector<Spec> build_specs() {
       index_of<SimPause>(),    index_of<SimResume>(), index_of<SimStep>(),    index_of<SimReset>(),
       index_of<SimSpeed>(),    index_of<SceneLoad>(), index_of<ParamSet>(),   index_of<CameraSet>(),
       index_of<CameraOrbit>(), index_of<ViewSet>(),   index_of<QualitySet>(), index_of<StateSave>(),
-      index_of<StateLoad>(),   index_of<FrameAck>(),  index_of<EmitterSet>(),
-      index_of<CameraReset>()};
+      index_of<StateLoad>(),   index_of<FrameAck>(),  index_of<EmitterSet>(), index_of<CameraReset>()};
   static_assert(std::size(indices) == std::variant_size_v<Command>, "one row per command");
   for (std::size_t i = 0; i < rows.size(); ++i) ordered[indices[i]] = std::move(rows[i]);
   for (std::size_t i = 0; i < ordered.size(); ++i) {
@@ -532,8 +539,7 @@ bool needs_controller(const Command& c) {
   // frames a second cut everyone to under 1 frame a second and the simulation from 50 to 4-40 steps/s.
   return !(std::holds_alternative<Hello>(c) || std::holds_alternative<CameraSet>(c) ||
            std::holds_alternative<CameraOrbit>(c) || std::holds_alternative<CameraReset>(c) ||
-           std::holds_alternative<ViewSet>(c) ||
-           std::holds_alternative<FrameAck>(c));
+           std::holds_alternative<ViewSet>(c) || std::holds_alternative<FrameAck>(c));
 }
 
 std::variant<Request, ParseError> parse(std::string_view text) {

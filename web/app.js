@@ -1,6 +1,8 @@
 // The thaw browser client: one WebSocket (subprotocol thaw.v1, docs/PROTOCOL.md) carrying JSON events
 // and binary frames (a 28-byte header, then JPEG). Every frame is acknowledged, so the server never
-// sends more than it can take; controls are protocol commands.
+// sends more than it can take; controls are protocol commands. The page shows the server's state: it
+// rebuilds its controls from `welcome` and from every `scene` event (a scene loaded, reset or restored
+// by any client), and follows the stats, so a reload or a second page shows what the server has.
 'use strict';
 
 const $ = (id) => document.getElementById(id);
@@ -12,10 +14,13 @@ const hud = $('hud');
 let ws = null;
 let nextId = 1;
 let welcome = null;
+let controller = false;
 let paused = false;
 let dryers = [];          // the scene's dryers as the server last described them
+let lamps = [];           // its lamps
 let emitters = [];        // and its taps (emitters), with their flow in L/s
-let history = [];         // [sim time, ice fraction, mean temperature]
+let history = [];         // [sim time, ice fraction or null, mean temperature or null]
+let pace = [];            // [wall ms, sim time] of recent stats, for the simulated seconds per wall second
 let reconnectDelay = 500;
 let framesSeen = 0, fpsWindowStart = performance.now(), fps = 0;
 
@@ -73,57 +78,153 @@ function onFrame(buffer) {
   });
 }
 
+// ---- the scene state: every control from what the server says --------------------------------------
+
+function indices(list) {
+  return list.map((_, i) => String(i));
+}
+
+// A select keeps the user's choice when the list it offers is the same length as before.
+function fillIndexSelect(select, list) {
+  const keep = select.options.length === list.length ? select.value : '0';
+  fillSelect(select, indices(list), keep);
+}
+
+function applyScene(m) {
+  $('scene-name').textContent = m.scene;
+  $('scene-name').title = m.description || '';
+  fillSelect($('scene'), (welcome && welcome.scenes) || [], m.scene);
+  dryers = m.dryers || [];
+  lamps = m.lamps || [];
+  emitters = m.emitters || [];
+  fillSelect($('dryer'), indices(dryers), '0');
+  fillSelect($('lamp'), indices(lamps), '0');
+  fillSelect($('emitter'), indices(emitters), '0');
+  applyLists();
+  applyView(m.view, m.quality);
+  applyPace(m.speed, m.heat_time_scale);
+  applyPaused(m.paused);
+  history = [];
+  pace = [];
+  drawPlot();
+}
+
+function applyLists() {
+  $('dryers').hidden = dryers.length === 0;
+  $('lamps').hidden = lamps.length === 0;
+  $('taps').hidden = emitters.length === 0;
+  showDryer();
+  showLamp();
+  showEmitter();
+}
+
+function applyView(view, quality) {
+  if (view) {
+    $('view-kind').value = view.view;
+    $('colour-by').value = view.colour_by;
+  }
+  if (quality && quality.surface) $('full-quality').checked = quality.surface === 'full';
+}
+
+// The speed select offers the server's factor even when another client chose one not in the list.
+function applyPace(speed, heatScale) {
+  if (speed !== undefined && document.activeElement !== $('speed')) {
+    const value = String(speed);
+    if (![...$('speed').options].some((o) => o.value === value)) {
+      const o = document.createElement('option');
+      o.value = value;
+      o.textContent = `${value} × real time`;
+      $('speed').appendChild(o);
+    }
+    $('speed').value = value;
+  }
+  if (heatScale !== undefined && document.activeElement !== $('heat-scale')) {
+    const value = String(heatScale);
+    if (![...$('heat-scale').options].some((o) => o.value === value)) {
+      const o = document.createElement('option');
+      o.value = value;
+      o.textContent = `× ${value}`;
+      $('heat-scale').appendChild(o);
+    }
+    $('heat-scale').value = value;
+  }
+}
+
+function applyPaused(p) {
+  paused = !!p;
+  $('pause').textContent = paused ? 'Resume' : 'Pause';
+}
+
 function onEvent(m) {
   switch (m.type) {
     case 'welcome':
       welcome = m;
-      $('scene-name').textContent = m.scene;
-      $('role').textContent = m.role === 'controller' ? '' : '(viewer: controls are off)';
-      // The frame is shared by every viewer, so only a controller sets its size and quality.
-      if (m.role === 'controller') send('quality.set', { width: canvas.width, height: canvas.height });
-      $('full-quality').disabled = m.role !== 'controller';
-      fillSelect($('scene'), m.scenes || [], m.scene);
-      dryers = m.dryers || [];
-      $('dryers').hidden = dryers.length === 0;
-      fillSelect($('dryer'), dryers.map((_, i) => String(i)), '0');
-      showDryer();
-      emitters = m.emitters || [];
-      $('taps').hidden = emitters.length === 0;
-      fillSelect($('emitter'), emitters.map((_, i) => String(i)), '0');
-      showEmitter();
-      history = [];
+      controller = m.role === 'controller';
+      $('role').textContent = controller ? '' : '(viewer: controls are off)';
+      for (const el of document.querySelectorAll('aside input, aside select, aside button'))
+        if (!el.classList.contains('anyone')) el.disabled = !controller;
+      // The frame is shared by every viewer, so only a controller sets its size.
+      if (controller) send('quality.set', { width: canvas.width, height: canvas.height });
+      applyScene(m);
+      break;
+    case 'scene':
+      applyScene(m);
       break;
     case 'stats':
-      paused = !!m.paused;
-      $('pause').textContent = paused ? 'Resume' : 'Pause';
-      if (m.dryers) dryers = m.dryers;
-      if (m.emitters) {
-        const changed = m.emitters.length !== emitters.length;
-        emitters = m.emitters;
-        $('taps').hidden = emitters.length === 0;
-        if (changed) fillSelect($('emitter'), emitters.map((_, i) => String(i)), '0');
-        showEmitter();
-      }
-      history.push([m.time, m.ice_fraction, m.temperature.mean]);
-      if (history.length > 2000) history.splice(0, history.length - 2000);
-      hud.textContent =
-        `t ${m.time.toFixed(3)} s   ${m.steps_per_second.toFixed(0)} steps/s   ${fps.toFixed(1)} fps\n` +
-        `ice ${(1000 * m.ice_mass).toFixed(2)} g (${(100 * m.ice_fraction).toFixed(1)} %)   ` +
-        `T mean ${m.temperature.mean.toFixed(2)} °C max ${m.temperature.max.toFixed(1)} °C\n` +
-        `particles ${m.particles.water} water, ${m.particles.ice} ice   ` +
-        (m.inflow ? `poured ${(1000 * m.inflow.mass).toFixed(1)} g   ` : '') +
-        (m.outflow ? `ran out ${(1000 * m.outflow.mass).toFixed(1)} g   ` : '') +
-        `energy closure ${m.energy.closure_relative.toExponential(1)}` + (m.error ? `\nstopped: ${m.error}` : '');
-      drawPlot();
+      onStats(m);
       break;
     case 'error':
       $('message').textContent = `${m.of || ''} ${m.code}: ${m.message}`;
       break;
     case 'ack':
       $('message').textContent = '';
-      if (m.of === 'scene.load' || m.of === 'sim.reset' || m.of === 'state.load') history = [];
       break;
   }
+}
+
+// Simulated seconds per wall second over the last few seconds of stats.
+function simRate() {
+  if (pace.length < 2) return null;
+  const [w0, t0] = pace[0], [w1, t1] = pace[pace.length - 1];
+  return w1 > w0 ? (t1 - t0) / ((w1 - w0) / 1000) : null;
+}
+
+function onStats(m) {
+  applyPaused(m.paused);
+  if (m.dryers) dryers = m.dryers;
+  if (m.lamps) lamps = m.lamps;
+  if (m.emitters) {
+    if (m.emitters.length !== emitters.length) fillIndexSelect($('emitter'), m.emitters);
+    emitters = m.emitters;
+  }
+  applyLists();
+  applyView(m.view, m.quality);
+  applyPace(m.speed, m.heat_time_scale);
+
+  const now = performance.now();
+  pace.push([now, m.time]);
+  while (pace.length > 2 && now - pace[0][0] > 3000) pace.shift();
+  const T = m.temperature;
+  history.push([m.time, m.ice_fraction, T ? T.mean : null]);
+  if (history.length > 2000) history.splice(0, history.length - 2000);
+
+  const rate = simRate();
+  const lines = [
+    `t ${m.time.toFixed(3)} s   ` +
+      (rate === null ? '' : `${rate < 0.1 ? rate.toPrecision(2) : rate.toFixed(2)} s simulated per s   `) +
+      `heat ×${m.heat_time_scale}   ${fps.toFixed(1)} fps`,
+  ];
+  if (m.ice_fraction !== null && m.ice_fraction !== undefined)
+    lines.push(`ice ${(1000 * m.ice_mass).toFixed(2)} g (${(100 * m.ice_fraction).toFixed(1)} % of the start)`);
+  if (T) lines.push(`T mean ${T.mean.toFixed(2)} °C, ${T.min.toFixed(1)} to ${T.max.toFixed(1)} °C`);
+  lines.push(
+    `particles ${m.particles.water} water, ${m.particles.ice} ice   ` +
+      (m.inflow ? `poured ${(1000 * m.inflow.mass).toFixed(1)} g   ` : '') +
+      (m.outflow ? `ran out ${(1000 * m.outflow.mass).toFixed(1)} g   ` : '') +
+      (m.energy ? `energy closure ${m.energy.closure_relative.toExponential(1)}` : ''));
+  if (m.error) lines.push(`stopped: ${m.error}`);
+  hud.textContent = lines.join('\n');
+  drawPlot();
 }
 
 function fillSelect(select, values, current) {
@@ -136,6 +237,14 @@ function fillSelect(select, values, current) {
   }
 }
 
+// ---- dryers, lamps, taps: the panel shows the selected one as the server has it, except the slider
+// a user is dragging ----------------------------------------------------------------------------------
+
+function setSlider(id, value, digits = 0) {
+  if (document.activeElement !== $(id)) $(id).value = value;
+  $(id + '-out').textContent = Number(value).toFixed(digits);
+}
+
 function currentDryer() {
   return Number($('dryer').value || 0);
 }
@@ -144,54 +253,101 @@ function showDryer() {
   const d = dryers[currentDryer()];
   if (!d) return;
   $('dryer-on').checked = d.on;
-  $('dryer-temp').value = d.temperature;
-  $('dryer-speed').value = d.speed;
-  $('dryer-temp-out').textContent = d.temperature;
-  $('dryer-speed-out').textContent = d.speed;
+  setSlider('dryer-temp', d.temperature);
+  setSlider('dryer-speed', d.speed, 1);
+}
+
+function currentLamp() {
+  return Number($('lamp').value || 0);
+}
+
+function showLamp() {
+  const l = lamps[currentLamp()];
+  if (!l) return;
+  $('lamp-on').checked = l.on;
+  setSlider('lamp-temp', l.temperature);
 }
 
 function currentEmitter() {
   return Number($('emitter').value || 0);
 }
 
-// The tap's controls follow the server, except the slider a user is dragging.
 function showEmitter() {
   const e = emitters[currentEmitter()];
   if (!e) return;
   $('emitter-open').checked = e.open;
-  if (document.activeElement !== $('emitter-rate')) $('emitter-rate').value = e.rate;
-  if (document.activeElement !== $('emitter-temp')) $('emitter-temp').value = e.temperature;
-  $('emitter-rate-out').textContent = Number(e.rate).toFixed(3);
-  $('emitter-temp-out').textContent = Number(e.temperature).toFixed(0);
+  setSlider('emitter-rate', e.rate, 3);
+  setSlider('emitter-temp', e.temperature);
+}
+
+// ---- the plot: ice left in % of the start (left axis) and the mean temperature (right axis) against
+// simulated time ---------------------------------------------------------------------------------------
+
+// Round bounds that hold [lo, hi] and span at least `least`.
+function niceRange(lo, hi, least) {
+  const mid = (lo + hi) / 2;
+  if (hi - lo < least) [lo, hi] = [mid - least / 2, mid + least / 2];
+  const step = Math.pow(10, Math.floor(Math.log10(hi - lo)));
+  return [Math.floor(lo / step) * step, Math.ceil(hi / step) * step];
 }
 
 function drawPlot() {
   const g = plot.getContext('2d');
-  g.clearRect(0, 0, plot.width, plot.height);
-  if (history.length < 2) return;
-  const t0 = history[0][0], t1 = history[history.length - 1][0] || 1;
-  const temps = history.map((h) => h[2]);
-  const lo = Math.min(...temps), hi = Math.max(...temps) + 1e-9;
-  const x = (t) => ((t - t0) / (t1 - t0 || 1)) * (plot.width - 10) + 5;
+  const W = plot.width, H = plot.height, left = 34, right = 40, top = 16, bottom = 22;
+  g.clearRect(0, 0, W, H);
+  g.font = '10px system-ui, sans-serif';
+  g.strokeStyle = '#555';
+  g.strokeRect(left, top, W - left - right, H - top - bottom);
+  if (history.length < 2) {
+    g.fillStyle = '#999';
+    g.fillText('waiting for the simulation…', left + 8, top + 20);
+    return;
+  }
+  const t0 = history[0][0], t1 = Math.max(history[history.length - 1][0], t0 + 1e-9);
+  const x = (t) => left + ((t - t0) / (t1 - t0)) * (W - left - right);
+  const y = (f) => top + (1 - f) * (H - top - bottom);
   const line = (value, colour) => {
     g.strokeStyle = colour;
     g.beginPath();
-    history.forEach((h, i) => {
-      const y = plot.height - 5 - value(h) * (plot.height - 10);
-      i ? g.lineTo(x(h[0]), y) : g.moveTo(x(h[0]), y);
-    });
+    let started = false;
+    for (const h of history) {
+      const v = value(h);
+      if (v === null) continue;
+      started ? g.lineTo(x(h[0]), y(v)) : g.moveTo(x(h[0]), y(v));
+      started = true;
+    }
     g.stroke();
   };
-  line((h) => h[1], '#9fd8ff');                      // ice fraction of the start, 0..1
-  line((h) => (h[2] - lo) / (hi - lo), '#ff9f6b');   // mean temperature, scaled to its range
-  g.fillStyle = '#9fd8ff';
-  g.fillText('ice fraction', 8, 12);
-  g.fillStyle = '#ff9f6b';
-  g.fillText(`mean T ${lo.toFixed(1)}–${hi.toFixed(1)} °C`, 90, 12);
+  g.fillStyle = '#ccc';
+  g.textAlign = 'center';
+  g.fillText(`${t0.toFixed(2)}`, left, H - 8);
+  g.fillText(`${t1.toFixed(2)} s simulated`, W - right - 30, H - 8);
+  const hasIce = history.some((h) => h[1] !== null && h[1] !== undefined);
+  if (hasIce) {
+    line((h) => (h[1] === null || h[1] === undefined ? null : Math.min(1, Math.max(0, h[1]))), '#9fd8ff');
+    g.fillStyle = '#9fd8ff';
+    g.textAlign = 'right';
+    g.fillText('100 %', left - 3, top + 4);
+    g.fillText('0 %', left - 3, H - bottom + 3);
+    g.textAlign = 'left';
+    g.fillText('ice left', left + 4, top - 4);
+  }
+  const temps = history.map((h) => h[2]).filter((v) => v !== null);
+  if (temps.length) {
+    // At least 2 °C tall, so round-off does not fill the plot with noise.
+    const [lo, hi] = niceRange(Math.min(...temps), Math.max(...temps), 2);
+    line((h) => (h[2] === null ? null : (h[2] - lo) / (hi - lo)), '#ff9f6b');
+    g.fillStyle = '#ff9f6b';
+    g.textAlign = 'left';
+    g.fillText(`${hi} °C`, W - right + 3, top + 4);
+    g.fillText(`${lo} °C`, W - right + 3, H - bottom + 3);
+    g.textAlign = 'right';
+    g.fillText('mean temperature', W - right - 4, top - 4);
+  }
 }
 
-// Orbit by dragging, zoom by the wheel; with "aim" ticked, a click or drag aims the dryer at the surface
-// under the pointer (the server picks it from the same field it renders).
+// ---- the canvas: orbit by dragging, zoom by the wheel; with "aim" ticked, a click or drag aims the
+// dryer at the surface under the pointer (the server picks it from the same field it renders) --------
 let drag = null;
 canvas.addEventListener('pointerdown', (e) => {
   drag = { x: e.offsetX, y: e.offsetY };
@@ -223,11 +379,18 @@ function aimAt(e) {
   send('dryer.aim', { dryer: currentDryer(), x: e.offsetX * sx, y: e.offsetY * sy });
 }
 
+// ---- controls -> commands ---------------------------------------------------------------------------
 $('aim').addEventListener('change', () => canvas.classList.toggle('aiming', $('aim').checked));
 $('pause').addEventListener('click', () => send(paused ? 'sim.resume' : 'sim.pause'));
 $('step').addEventListener('click', () => send('sim.step', { n: 10 }));
 $('reset').addEventListener('click', () => send('sim.reset'));
+$('reset-view').addEventListener('click', () => send('camera.reset'));
 $('scene').addEventListener('change', (e) => send('scene.load', { name: e.target.value }));
+$('speed').addEventListener('change', (e) => send('sim.speed', { factor: Number(e.target.value) }));
+// A new heat time scale rebuilds the simulation from its particles (param.set's rebuild).
+$('heat-scale').addEventListener('change', (e) =>
+  send('param.set', { path: 'heat.time_scale', value: Number(e.target.value) }));
+
 $('dryer').addEventListener('change', showDryer);
 $('dryer-on').addEventListener('change', (e) => send('dryer.set', { dryer: currentDryer(), on: e.target.checked }));
 $('dryer-temp').addEventListener('input', (e) => {
@@ -235,9 +398,17 @@ $('dryer-temp').addEventListener('input', (e) => {
   send('dryer.set', { dryer: currentDryer(), temperature: Number(e.target.value) });
 });
 $('dryer-speed').addEventListener('input', (e) => {
-  $('dryer-speed-out').textContent = e.target.value;
+  $('dryer-speed-out').textContent = Number(e.target.value).toFixed(1);
   send('dryer.set', { dryer: currentDryer(), speed: Number(e.target.value) });
 });
+
+$('lamp').addEventListener('change', showLamp);
+$('lamp-on').addEventListener('change', (e) => send('lamp.set', { lamp: currentLamp(), on: e.target.checked }));
+$('lamp-temp').addEventListener('input', (e) => {
+  $('lamp-temp-out').textContent = e.target.value;
+  send('lamp.set', { lamp: currentLamp(), temperature: Number(e.target.value) });
+});
+
 $('emitter').addEventListener('change', showEmitter);
 $('emitter-open').addEventListener('change', (e) => send('emitter.set', { emitter: currentEmitter(), open: e.target.checked }));
 $('emitter-rate').addEventListener('input', (e) => {
@@ -249,9 +420,10 @@ $('emitter-temp').addEventListener('change', (e) => {
   $('emitter-temp-out').textContent = e.target.value;
   send('emitter.set', { emitter: currentEmitter(), temperature: Number(e.target.value) });
 });
+
 const sendView = () => send('view.set', { view: $('view-kind').value, colour_by: $('colour-by').value });
 $('view-kind').addEventListener('change', sendView);
-$('full-quality').addEventListener('change', (e) => send('quality.set', { surface: e.target.checked ? 'full' : 'fast' }));
 $('colour-by').addEventListener('change', sendView);
+$('full-quality').addEventListener('change', (e) => send('quality.set', { surface: e.target.checked ? 'full' : 'fast' }));
 
 connect();

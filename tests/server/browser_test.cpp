@@ -151,5 +151,61 @@ async def scenario(call, js, until):
   EXPECT_TRUE(served.stop()) << served.log();
 }
 
+// The page is the server's state: its controls come from the welcome (the dryer's slider shows the
+// server's temperature, the speed and heat selects the server's pace); a dryer slider moves the server's
+// dryer; "Reset view" puts the scene's camera back (a second client's welcome says where the camera is);
+// a scene change by the select rebuilds the header and the panels (icicles-lamp has a lamp and no
+// dryer) and the lamp control switches the lamp; back in default the sliders show the new scene's
+// values, not the old page's; after a reload the page shows the quality the server has.
+TEST(BrowserClient, ThePageFollowsTheServerAcrossScenesAndReloads) {
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
+      << "Debian's chromium is not installed (scripts/setup)";
+  TempDir dir("browser-state");
+  ServedScene served(dir, "default --set spacing=0.006 --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(in_chromium(R"py(
+import thaw_client
+URL = f"ws://127.0.0.1:{PORT}/"
+async def camera_now():
+    async with thaw_client.connect(URL) as other:
+        return other.welcome["camera"]["azimuth"]
+def value(id):
+    return f"document.getElementById('{id}').value"
+async def scenario(call, js, until):
+    print("welcome", await until("document.getElementById('scene-name').textContent === 'default' && dryers.length === 1", 30))
+    print("sliders", await js(value('dryer-temp')), await js(value('speed')), await js(value('heat-scale')))
+    await js("{ const s = document.getElementById('dryer-temp'); s.value = 120; s.dispatchEvent(new Event('input')); }")
+    print("dryer set", bool(await until("dryers[0].temperature === 120", 20)))
+    await js("send('camera.orbit', {d_azimuth: 40})")
+    await asyncio.sleep(0.5)
+    print("orbited", await camera_now())
+    await js("document.getElementById('reset-view').click()")
+    await asyncio.sleep(0.5)
+    print("reset view", await camera_now())
+    await js("{ const s = document.getElementById('scene'); s.value = 'icicles-lamp'; s.dispatchEvent(new Event('change')); }")
+    print("scene changed", bool(await until("document.getElementById('scene-name').textContent === 'icicles-lamp'", 60)))
+    print("panels", await js("[document.getElementById('dryers').hidden, document.getElementById('lamps').hidden, lamps.length].join(' ')"))
+    on = await js("lamps[0].on")
+    await js("document.getElementById('lamp-on').click()")
+    print("lamp toggled", bool(await until(f"lamps[0].on === {json.dumps(not on)}", 20)))
+    await js("{ const s = document.getElementById('scene'); s.value = 'default'; s.dispatchEvent(new Event('change')); }")
+    print("back", bool(await until("document.getElementById('scene-name').textContent === 'default' && dryers.length === 1", 60)))
+    print("fresh sliders", await js(value('dryer-temp')), await js("document.getElementById('dryers').hidden"))
+    await js("document.getElementById('full-quality').click()")
+    await asyncio.sleep(0.5)
+    await call("Page.reload")
+    await asyncio.sleep(1)
+    print("reloaded", bool(await until("welcome && document.getElementById('full-quality').checked", 30)))
+)py"),
+                                            240, &status);
+  EXPECT_EQ(status, 0) << out;
+  expect_lines(out, {"connected True", "welcome True", "sliders 70 0 100", "dryer set True", "orbited 70.0",
+                     "reset view 30.0", "scene changed True", "panels true false 1", "lamp toggled True",
+                     "back True", "fresh sliders 70 False", "reloaded True", "screenshot True"});
+  std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
+  EXPECT_TRUE(served.stop()) << served.log();
+}
+
 }  // namespace
 }  // namespace thaw

@@ -201,6 +201,7 @@ TEST(ProtocolParse, SimulationControl) {
   EXPECT_EQ(parsed<SimStep>(R"({"type":"sim.step"})").n, 1);
   EXPECT_EQ(parsed<SimStep>(R"({"type":"sim.step","n":10000})").n, 10000);
   EXPECT_EQ(parsed<SimSpeed>(R"({"type":"sim.speed","factor":0.25})").factor, 0.25);
+  EXPECT_EQ(parsed<SimSpeed>(R"({"type":"sim.speed","factor":0})").factor, 0.0) << "as fast as possible";
   EXPECT_EQ(parsed<SimSpeed>(R"({"type":"sim.speed","factor":1000})").factor, 1000.0);
 }
 
@@ -484,7 +485,7 @@ TEST(ProtocolRefuse, SimulationControl) {
       {R"({"type":"sim.step","n":2.5})", "sim.step", "n"},
       {R"({"type":"sim.step","n":"5"})", "sim.step", "n"},
       {R"({"type":"sim.speed"})", "sim.speed", "factor"},
-      {R"({"type":"sim.speed","factor":0})", "sim.speed", "factor"},
+      {R"({"type":"sim.speed","factor":0.0005})", "sim.speed", "factor"},
       {R"({"type":"sim.speed","factor":-1})", "sim.speed", "factor"},
       {R"({"type":"sim.speed","factor":1001})", "sim.speed", "factor"},
       {R"({"type":"sim.speed","factor":"fast"})", "sim.speed", "factor"},
