@@ -37,16 +37,16 @@ constexpr float kMarginSigmas = 2.5f;
 // The Gaussian is cut at this many of its standard deviations (weight lost: 0.3 %, renormalised).
 constexpr float kBlurCutoff = 3.0f;
 
-constexpr int kIce = 0, kWater = 1, kSolid = 2, kSlots = 3;
+constexpr int kIce = 0, kWater = 1, kSolid = 2, kGlass = 3, kSlots = 4;
 
-int slot_of(std::uint8_t phase) {
+int slot_of(std::uint8_t phase, bool glass = false) {
   switch (static_cast<Phase>(phase)) {
     case Phase::Ice:
       return kIce;
     case Phase::Water:
       return kWater;
     case Phase::Solid:
-      return kSolid;
+      return glass ? kGlass : kSolid;
     case Phase::Air:
       break;
   }
@@ -180,13 +180,17 @@ DensityFields build_density_fields(const RenderSnapshot& s, const FieldOptions& 
   if (s.phase.size() != s.position.size())
     throw Error("density field: " + std::to_string(s.phase.size()) + " phases for " +
                 std::to_string(s.position.size()) + " particles");
+  if (!s.glass.empty() && s.glass.size() != s.position.size())
+    throw Error("density field: " + std::to_string(s.glass.size()) + " glass flags for " +
+                std::to_string(s.position.size()) + " particles");
+  const auto slot_at = [&](std::size_t p) { return slot_of(s.phase[p], !s.glass.empty() && s.glass[p]); };
 
   // The grid covers what is drawn (not air, not a particle that has left the numbers behind); the
   // snapshot's bounds include every particle, so they are recomputed here.
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
   std::size_t drawn = 0;
   for (std::size_t p = 0; p < s.position.size(); ++p) {
-    if (slot_of(s.phase[p]) < 0 || !finite(s.position[p])) continue;
+    if (slot_at(p) < 0 || !finite(s.position[p])) continue;
     lo = lo.cwiseMin(s.position[p]);
     hi = hi.cwiseMax(s.position[p]);
     ++drawn;
@@ -223,7 +227,7 @@ DensityFields build_density_fields(const RenderSnapshot& s, const FieldOptions& 
   std::vector<std::size_t> start(std::size_t(kSlots) * g.nz + 1, 0);
   std::array<IndexBox, kSlots> box;
   for (std::size_t p = 0; p < s.position.size(); ++p) {
-    const int slot = slot_of(s.phase[p]);
+    const int slot = slot_at(p);
     if (slot < 0 || !finite(s.position[p])) continue;
     const Eigen::Vector3f u = (s.position[p] - g.origin) * inv_cell;
     Eigen::Vector3i c;
@@ -248,11 +252,12 @@ DensityFields build_density_fields(const RenderSnapshot& s, const FieldOptions& 
   // thread), while independent tasks meet once. Each field is computed by one thread in one order, so
   // the result does not depend on the thread count.
   const std::vector<float> w = gaussian_weights(layout.sigma_cells);
-  std::array<std::vector<float>*, kSlots> fields{&f.ice, &f.water, &f.solid};
+  std::array<std::vector<float>*, kSlots> fields{&f.ice, &f.water, &f.solid, &f.glass};
   const std::size_t dy = std::size_t(g.nx), dz = std::size_t(g.nx) * g.ny;
 #pragma omp parallel for schedule(dynamic, 1)
   for (int slot = 0; slot < kSlots; ++slot) {
     std::vector<float>& field = *fields[slot];
+    if (slot == kGlass && s.glass.empty()) continue;  // no glass: no field
     field.assign(g.size(), 0.0f);
     for (std::size_t q = start[std::size_t(slot) * g.nz]; q < start[std::size_t(slot + 1) * g.nz]; ++q) {
       const Deposit& dep = deposits[order[q]];

@@ -1,8 +1,8 @@
 #pragma once
-// The metaball fields the renderer ray-marches and the mesh exporter contours: for each of ice, water
-// and static solids, a scalar field on one regular grid over the particles, about 1 inside the phase's
-// particles and falling to 0 outside; the surface is the iso-level `iso` (0.5: about half a spacing
-// beyond the outermost particle centres).
+// The metaball fields the renderer ray-marches and the mesh exporter contours: for each of ice, water,
+// static solids and glass (solids of a transparent material), a scalar field on one regular grid over the
+// particles, about 1 inside the phase's particles and falling to 0 outside; the surface is the iso-level
+// `iso` (0.5: about half a spacing beyond the outermost particle centres).
 #include <Eigen/Core>
 #include <cstddef>
 #include <vector>
@@ -21,14 +21,14 @@ struct FieldGrid {
 };
 
 struct FieldOptions {
-  int max_cells = 128;      // nodes along the longest axis of the particles' bounds (plus margins)
-  float iso = 0.5f;         // surface level
+  int max_cells = 128;  // nodes along the longest axis of the particles' bounds (plus margins)
+  float iso = 0.5f;     // surface level
 };
 
 struct DensityFields {
   FieldGrid grid;
   float iso = 0.5f;
-  std::vector<float> ice, water, solid;  // grid.size() values each
+  std::vector<float> ice, water, solid, glass;  // grid.size() values each; glass empty when there is none
 };
 
 DensityFields build_density_fields(const RenderSnapshot& s, const FieldOptions& options = {});

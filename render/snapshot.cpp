@@ -1,5 +1,6 @@
 #include "render/snapshot.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "sim/error.h"
@@ -23,6 +24,13 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
   }
   if (p.size() == 0) s.bounds_min = s.bounds_max = Eigen::Vector3f::Zero();
   s.phase = p.phase;
+  if (std::any_of(scene.materials.begin(), scene.materials.end(),
+                  [](const Material& m) { return m.transparent; }) &&
+      p.material.size() == p.size()) {
+    s.glass.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i)
+      s.glass[i] = p.material[i] < scene.materials.size() && scene.materials[p.material[i]].transparent;
+  }
   s.temperature = temperature;
   s.spacing = static_cast<float>(scene.spacing);
   s.domain_min = scene.domain.min.cast<float>();

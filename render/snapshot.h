@@ -13,16 +13,18 @@ namespace thaw {
 struct RenderSnapshot {
   std::vector<Eigen::Vector3f> position;  // [m]
   std::vector<std::uint8_t> phase;        // thaw::Phase
+  std::vector<std::uint8_t> glass;        // 1 for a solid particle of a transparent material; empty: none
   std::vector<float> temperature;         // [°C]; empty when the scene has no heat
   float spacing = 0;                      // particle spacing [m]
   Eigen::Vector3f domain_min = Eigen::Vector3f::Zero(), domain_max = Eigen::Vector3f::Zero();
-  Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(), bounds_max = Eigen::Vector3f::Zero();  // of every particle
+  Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(),
+                  bounds_max = Eigen::Vector3f::Zero();  // of every particle
   double time = 0;
   std::uint64_t step = 0;
 };
 
 // `temperature` may be empty; otherwise one per particle in p's order.
-RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& temperature, const Scene& scene,
-                             double time, std::uint64_t step);
+RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& temperature,
+                             const Scene& scene, double time, std::uint64_t step);
 
 }  // namespace thaw

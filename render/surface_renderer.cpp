@@ -134,12 +134,12 @@ void SurfaceRenderer::resize_volume(int nx, int ny, int nz) {
 void SurfaceRenderer::upload(const DensityFields& f) {
   const auto t0 = Clock::now();
   const FieldGrid& g = f.grid;
-  for (const auto* v : {&f.ice, &f.water, &f.solid})
+  for (const auto* v : {&f.ice, &f.water, &f.solid, &f.glass})
     if (!v->empty() && v->size() != g.size())
       throw Error("surface renderer: a phase field holds " + std::to_string(v->size()) +
                   " values for a grid of " + std::to_string(g.size()) + " nodes");
   has_volume_ = g.nx >= 2 && g.ny >= 2 && g.nz >= 2 && g.cell > 0 &&
-                !(f.ice.empty() && f.water.empty() && f.solid.empty());
+                !(f.ice.empty() && f.water.empty() && f.solid.empty() && f.glass.empty());
   grid_ = g;
   iso_ = f.iso;
   if (!has_volume_) {
@@ -154,15 +154,17 @@ void SurfaceRenderer::upload(const DensityFields& f) {
   const float* ice = f.ice.empty() ? nullptr : f.ice.data();
   const float* water = f.water.empty() ? nullptr : f.water.data();
   const float* solid = f.solid.empty() ? nullptr : f.solid.data();
+  const float* glass = f.glass.empty() ? nullptr : f.glass.data();
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     const float a = ice ? ice[i] : 0.0f, b = water ? water[i] : 0.0f, c = solid ? solid[i] : 0.0f;
-    max_field_[i] = std::max({a, b, c});
+    const float e = glass ? glass[i] : 0.0f;
+    max_field_[i] = std::max({a, b, c, e});
     std::uint8_t* p = &phase_bytes_[4 * i];
     p[0] = unit_byte(a);
     p[1] = unit_byte(b);
     p[2] = unit_byte(c);
-    p[3] = 0;
+    p[3] = unit_byte(e);
   }
 
   // Blocks span nodes [b * kBlock, b * kBlock + kBlock] inclusive: the trilinear field anywhere inside the
@@ -179,7 +181,7 @@ void SurfaceRenderer::upload(const DensityFields& f) {
     for (int jb = 0; jb < by; ++jb)
       for (int ib = 0; ib < bx; ++ib) {
         float m = 0.0f;
-        int inside[3] = {0, 0, 0}, count = 0;
+        int inside[4] = {0, 0, 0, 0}, count = 0;
         for (int k = kb * kBlock; k <= std::min(kb * kBlock + kBlock, g.nz - 1); ++k)
           for (int j = jb * kBlock; j <= std::min(jb * kBlock + kBlock, g.ny - 1); ++j) {
             const std::size_t row = g.index(0, j, k);
@@ -188,16 +190,18 @@ void SurfaceRenderer::upload(const DensityFields& f) {
               inside[0] += ice && ice[row + i] >= iso;
               inside[1] += water && water[row + i] >= iso;
               inside[2] += solid && solid[row + i] >= iso;
+              inside[3] += glass && glass[row + i] >= iso;
               ++count;
             }
           }
         const std::size_t b = (std::size_t(kb) * by + jb) * bx + ib;
         skip[b] = m >= iso ? 0 : kMaxSkip;
-        const float frac[3] = {float(inside[0]) / float(count), float(inside[1]) / float(count),
-                               float(inside[2]) / float(count)};
-        block_data_[4 * b + 1] = frac[0] + frac[1] + frac[2];
-        extinction_[b] =
-            kShadowExtinction[0] * frac[0] + kShadowExtinction[1] * frac[1] + kShadowExtinction[2] * frac[2];
+        float frac[4];
+        for (int q = 0; q < 4; ++q) frac[q] = float(inside[q]) / float(count);
+        // Glass occludes the ambient light a little (it is a thin wall) and casts a faint shadow.
+        block_data_[4 * b + 1] = frac[0] + frac[1] + frac[2] + 0.3f * frac[3];
+        extinction_[b] = kShadowExtinction[0] * frac[0] + kShadowExtinction[1] * frac[1] +
+                         kShadowExtinction[2] * frac[2] + kShadowExtinction[3] * frac[3];
       }
   chebyshev_distance(skip, bx, by, bz);
 

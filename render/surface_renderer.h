@@ -1,6 +1,6 @@
 #pragma once
-// The metaball view (docs/ARCHITECTURE.md, Renderer): the iso-surfaces of the ice, water and solid density fields,
-// ray-marched in a fragment shader (render/shaders/surface.frag) into an off-screen RGBA8 framebuffer
+// The metaball view (docs/ARCHITECTURE.md, Renderer): the iso-surfaces of the ice, water and solid density
+// fields, ray-marched in a fragment shader (render/shaders/surface.frag) into an off-screen RGBA8 framebuffer
 // and read back as an Image.
 //
 // What goes to the GPU per frame, and why:
@@ -61,7 +61,7 @@ class SurfaceRenderer {
   static constexpr int kShadowSteps = 16;  // blocks toward the light that can shadow a point
   // Shadow extinction per cell of light path inside ice, water, solid: translucent phases cast pale
   // shadows, solids dark ones.
-  static constexpr float kShadowExtinction[3] = {0.06f, 0.02f, 0.45f};
+  static constexpr float kShadowExtinction[4] = {0.06f, 0.02f, 0.45f, 0.03f};  // ice, water, solid, glass
 
  private:
   void upload(const DensityFields& fields);

@@ -236,6 +236,7 @@ Material material_from_json(const std::string& name, const Json& m) {
   mat.viscosity = m["viscosity"].get<double>();
   mat.conductivity = m["conductivity"].get<double>();
   mat.specific_heat = m["specific_heat"].get<double>();
+  mat.transparent = m.contains("transparent") && m["transparent"].get<bool>();  // solids only
   return mat;
 }
 

@@ -46,6 +46,7 @@ struct Material {
   double latent_heat = 0.0;    // L [J/kg] of an ice and the fluid it melts into; 0 otherwise
   double melting_point = 0.0;  // T_m [°C] of the same pair
   int partner = -1;            // ice: the fluid it melts into; fluid: the ice it freezes into; -1 none
+  bool transparent = false;    // solids: drawn as glass (the renderer's business only)
   // Variants the scene loader adds (named "<material> (...)"): a solid held at a temperature, and the
   // tank walls when they exchange heat with the outside.
   bool held = false;

@@ -310,6 +310,11 @@ const Field& scene_schema() {
                          .in("J/kg/K")
                          .at_least(1)
                          .at_most(1e6),
+                     flag("transparent",
+                          "Drawn as glass: clear and slightly tinted, with Fresnel reflection, so what it "
+                          "holds shows through (solids; rendering only)")
+                         .def(false)
+                         .when("kind", "solid"),
                      text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
                          .when("kind", "ice"),
                      number("latent_heat", "Latent heat of fusion L")

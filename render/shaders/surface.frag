@@ -9,6 +9,9 @@
 //   ice    Fresnel reflection over a milky pale blue: light scattered inside, in front of what lies
 //          behind, both weighted by Beer-Lambert extinction along the path through the ice;
 //   water  the same with little scattering and a stronger, bluer absorption: clear and tinted.
+//   glass  (solids of a transparent material) Fresnel reflection, a faint haze, and the rest of the light
+//          passing on through the wall, tinted by Beer-Lambert along the path inside it: the ray goes on
+//          to what the glass holds, through up to kGlassLayers walls.
 // Translucent phases show what lies behind them along the straight ray (no refraction), shaded opaque.
 // Contact cues: ambient occlusion from the fields along the normal, and soft shadows from the blocks'
 // precomputed light transmittance.
@@ -21,7 +24,7 @@ precision highp int;
 precision highp sampler3D;
 
 uniform sampler3D u_field;   // max of the phases, linear
-uniform sampler3D u_phases;  // ice, water, solid in [0, 1], linear
+uniform sampler3D u_phases;  // ice, water, solid, glass in [0, 1], linear
 uniform sampler3D u_blocks;  // per block: skip distance, fraction inside, light transmittance
 uniform int u_has_volume;
 uniform vec3 u_nodes;        // nodes per axis
@@ -54,18 +57,27 @@ const vec3 kWaterColour = vec3(0.08, 0.30, 0.52);
 const float kWaterScattering = 1.5;
 const vec3 kWaterAbsorption = vec3(4.5, 1.6, 0.6);
 const vec3 kSolidColour = vec3(0.56, 0.56, 0.54);
-// Fresnel reflectance at normal incidence, ((n - 1) / (n + 1))^2 with n = 1.31 (ice), 1.33 (water).
+// Fresnel reflectance at normal incidence, ((n - 1) / (n + 1))^2 with n = 1.31 (ice), 1.33 (water),
+// 1.5 (glass).
 const float kIceF0 = 0.018;
 const float kWaterF0 = 0.020;
+const float kGlassF0 = 0.040;
+// Soda-lime glass is faintly green: clear through a wall, green along one seen edge-on.
+const vec3 kGlassAbsorption = vec3(1.6, 0.5, 1.0);
+const vec3 kGlassColour = vec3(0.80, 0.88, 0.86);
+const float kGlassHaze = 0.05;
+const int kGlassLayers = 4;   // glass surfaces a ray passes: into and out of a glass's two walls
+const int kMaxGlass = 48;     // cells through one glass wall
 
 vec3 tex_coord(vec3 g) { return (g + 0.5) / u_nodes; }
 float field(vec3 g) { return texture(u_field, tex_coord(g)).r; }
-vec3 phases(vec3 g) { return texture(u_phases, tex_coord(g)).rgb; }
+vec4 phases(vec3 g) { return texture(u_phases, tex_coord(g)); }
 // Block b's texel centre lies at the centre of its cells, (b + 0.5) * u_block.
 vec4 coarse(vec3 g) { return texture(u_blocks, g / (u_block * u_block_count)); }
 
-// 0 = ice, 1 = water, 2 = solid: the phase with the largest field.
-int dominant(vec3 ph) {
+// 0 = ice, 1 = water, 2 = solid, 3 = glass: the phase with the largest field.
+int dominant(vec4 ph) {
+  if (ph.a > ph.b && ph.a >= ph.r && ph.a >= ph.g) return 3;
   if (ph.b >= ph.r && ph.b >= ph.g) return 2;
   return ph.r >= ph.g ? 0 : 1;
 }
@@ -150,49 +162,35 @@ vec3 diffuse(vec3 base, vec3 n, float ao, float sh) {
 
 vec3 lit(vec3 base, vec3 p, vec3 n) { return diffuse(base, n, occlusion(p, n), shadow(p, n)); }
 
-void main() {
-  vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
-  vec3 d = normalize(u_forward + ndc.x * u_right + ndc.y * u_up);
-  vec3 colour = background(d);
-  if (u_has_volume == 0) {
-    o_colour = vec4(colour, 1.0);
-    return;
-  }
-  // Keep 1/d finite: an axis-parallel ray would give 0 * inf = NaN at the box faces.
-  d = mix(d, mix(vec3(1e-6), vec3(-1e-6), lessThan(d, vec3(0.0))), lessThan(abs(d), vec3(1e-6)));
-  vec3 inv = 1.0 / d;
-  vec2 span = clip_to_box(u_eye, inv);
-  float t = span.x > span.y ? -1.0 : first_hit(u_eye, d, inv, span.x, span.y);
-  if (t < 0.0) {
-    o_colour = vec4(colour, 1.0);
-    return;
-  }
-  vec3 p = u_eye + t * d;
-  int phase = dominant(phases(p));
-  vec3 n;
+float schlick(float f0, vec3 n, vec3 d) {
+  return f0 + (1.0 - f0) * pow(1.0 - clamp(dot(n, -d), 0.0, 1.0), 5.0);
+}
+
+// The surface normal where the ray first meets the grid at t: a phase cut by the box has the face the
+// ray came in through as its surface.
+vec3 normal_at(vec3 p, vec3 d, vec3 inv, vec2 span, float t) {
   if (t == span.x && span.x > 0.0) {
-    // A phase cut by the box: the face the ray came in through is its surface.
     vec3 lo = min(-u_eye * inv, (u_nodes - 1.0 - u_eye) * inv);
-    n = -sign(d) * step(span.x - 1e-4, lo);
-    n = length(n) > 0.0 ? normalize(n) : -d;
-  } else {
-    n = outward_normal(p, d);
+    vec3 n = -sign(d) * step(span.x - 1e-4, lo);
+    return length(n) > 0.0 ? normalize(n) : -d;
   }
+  return outward_normal(p, d);
+}
+
+// The colour of an opaque solid, ice or water (phase 0, 1, 2) hit at t with normal n.
+vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
   float ao = occlusion(p, n), sh = shadow(p, n);
-  if (phase == 2) {
-    o_colour = vec4(diffuse(kSolidColour, n, ao, sh), 1.0);
-    return;
-  }
+  if (phase == 2) return diffuse(kSolidColour, n, ao, sh);
 
   // Walk through ice and water to their far side, or to a solid inside them, summing the path in each.
-  // One RGBA8 fetch per step tells all three phases apart. The exit is then refined by bisection
-  // (after the loop, as in first_hit): a path quantised to whole steps shows as contour bands.
+  // One RGBA8 fetch per step tells the phases apart. The exit is then refined by bisection (after the
+  // loop, as in first_hit): a path quantised to whole steps shows as contour bands.
   float path_ice = 0.0, path_water = 0.0, w = phase == 0 ? 1.0 : 0.0;  // w: the ice share of the medium
   float tb = t, tn = t;
   bool left = false;
   for (int i = 0; i < kMaxInside; ++i) {
     tn = min(tb + kInsideStep, span.y);
-    vec3 ph = phases(u_eye + tn * d);
+    vec4 ph = phases(u_eye + tn * d);
     if (max(ph.r, ph.g) < u_iso || tn >= span.y) {
       left = true;
       break;
@@ -207,7 +205,7 @@ void main() {
     float inside_to = tb;
     for (int k = 0; k < kBisections; ++k) {
       float m = 0.5 * (inside_to + tn);
-      vec3 ph = phases(u_eye + m * d);
+      vec4 ph = phases(u_eye + m * d);
       if (max(ph.r, ph.g) < u_iso)
         tn = m;
       else
@@ -236,8 +234,10 @@ void main() {
     if (t2 >= 0.0) {
       vec3 q = u_eye + t2 * d;
       int behind = dominant(phases(q));
-      back = lit(behind == 2 ? kSolidColour : behind == 0 ? kIceColour * 0.85 : kWaterColour * 1.4, q,
-                 outward_normal(q, d));
+      // Glass behind the medium (a glass's far wall): the background, tinted, through it.
+      back = behind == 3 ? background(d) * kGlassColour
+                         : lit(behind == 2 ? kSolidColour : behind == 0 ? kIceColour * 0.85 : kWaterColour * 1.4,
+                               q, outward_normal(q, d));
     }
   }
 
@@ -253,11 +253,59 @@ void main() {
 
   // Schlick's approximation of the Fresnel reflectance (Schlick 1994, "An inexpensive BRDF model for
   // physically-based rendering"), reflecting the background, plus a highlight of the key light.
-  float f0 = phase == 0 ? kIceF0 : kWaterF0;
-  float fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(n, -d), 0.0, 1.0), 5.0);
+  float fresnel = schlick(phase == 0 ? kIceF0 : kWaterF0, n, d);
   vec3 r = reflect(d, n);
   float shininess = phase == 0 ? 40.0 : 120.0;  // ice's surface is rougher than water's
   float highlight = (phase == 0 ? 0.35 : 0.8) * pow(max(dot(r, u_light), 0.0), shininess) * sh;
-  colour = mix(body, background(r), fresnel) + highlight;
+  return mix(body, background(r), fresnel) + highlight;
+}
+
+void main() {
+  vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
+  vec3 d = normalize(u_forward + ndc.x * u_right + ndc.y * u_up);
+  if (u_has_volume == 0) {
+    o_colour = vec4(background(d), 1.0);
+    return;
+  }
+  // Keep 1/d finite: an axis-parallel ray would give 0 * inf = NaN at the box faces.
+  d = mix(d, mix(vec3(1e-6), vec3(-1e-6), lessThan(d, vec3(0.0))), lessThan(abs(d), vec3(1e-6)));
+  vec3 inv = 1.0 / d;
+  vec2 span = clip_to_box(u_eye, inv);
+
+  // Glass passes part of the light on: `through` is how much of what lies further along reaches the eye.
+  vec3 colour = vec3(0.0), through = vec3(1.0);
+  float from = span.x;
+  bool ended = false;
+  for (int layer = 0; layer < kGlassLayers; ++layer) {
+    float t = span.x > span.y || from >= span.y ? -1.0 : first_hit(u_eye, d, inv, from, span.y);
+    if (t < 0.0) {
+      colour += through * background(d);
+      ended = true;
+      break;
+    }
+    vec3 p = u_eye + t * d;
+    int phase = dominant(phases(p));
+    vec3 n = normal_at(p, d, inv, span, t);
+    if (phase != 3) {
+      colour += through * shade(p, n, d, inv, span, t, phase);
+      ended = true;
+      break;
+    }
+    // Glass: the reflection and a faint haze here; the rest goes on through the wall, to its far face.
+    float f = schlick(kGlassF0, n, d);
+    vec3 r = reflect(d, n);
+    float sh = shadow(p, n);
+    float highlight = 0.6 * pow(max(dot(r, u_light), 0.0), 200.0) * sh;
+    vec3 haze = kGlassColour * (0.45 * ambient(n) + 0.4 * max(dot(n, u_light), 0.0) * sh);
+    colour += through * (f * background(r) + kGlassHaze * haze + highlight);
+    float te = t;
+    for (int i = 0; i < kMaxGlass; ++i) {
+      te = min(te + 1.0, span.y);
+      if (te >= span.y || phases(u_eye + te * d).a < u_iso) break;
+    }
+    through *= (1.0 - f - kGlassHaze) * exp(-kGlassAbsorption * ((te - t) * u_scale));
+    from = te + 0.5;  // past where the 8-bit glass field still reads near iso
+  }
+  if (!ended) colour += through * background(d);
   o_colour = vec4(clamp(colour, 0.0, 1.0), 1.0);
 }

@@ -357,14 +357,17 @@ TEST_F(RenderTest, EmptyFieldsGiveTheBackground) {
 // Fast quality drops only what shows through ice and water: a solid alone renders the same, while the
 // slab seen through the water block changes.
 TEST_F(RenderTest, FastQualityDiffersOnlyBehindIceAndWater) {
-  DensityFields solid_only = empty_fields(Vector3f(-0.40f, -0.30f, -0.12f), Vector3f(0.40f, 0.30f, 0.30f), 64);
+  DensityFields solid_only =
+      empty_fields(Vector3f(-0.40f, -0.30f, -0.12f), Vector3f(0.40f, 0.30f, 0.30f), 64);
   add_body(solid_only, solid_only.solid, box({-0.36f, -0.26f, -0.08f}, {0.36f, 0.26f, 0.0f}),
            2.0f * solid_only.grid.cell);
   const DensityFields scene = scene_fields(64);
   const OrbitCamera camera = scene_camera(160, 120);
-  const Image full_solid = renderer().render(solid_only, camera), full_scene = renderer().render(scene, camera);
+  const Image full_solid = renderer().render(solid_only, camera),
+              full_scene = renderer().render(scene, camera);
   renderer().set_quality(SurfaceRenderer::Quality::Fast);
-  const Image fast_solid = renderer().render(solid_only, camera), fast_scene = renderer().render(scene, camera);
+  const Image fast_solid = renderer().render(solid_only, camera),
+              fast_scene = renderer().render(scene, camera);
   renderer().set_quality(SurfaceRenderer::Quality::Full);
   EXPECT_EQ(full_solid.rgba, fast_solid.rgba);
   int changed = 0;
@@ -372,6 +375,57 @@ TEST_F(RenderTest, FastQualityDiffersOnlyBehindIceAndWater) {
     for (int x = 0; x < camera.width; ++x) changed += differs(full_scene, fast_scene, x, y, 2);
   EXPECT_GT(changed, 50) << "the water block and the ice sphere show the slab behind them in full quality";
   EXPECT_GT(psnr(full_scene, fast_scene), 20.0) << "and nothing else changes much";
+}
+
+// A cup: an open-topped box shell of `wall` thickness into `phase`, its inside [lo, hi] without the top.
+void add_cup(DensityFields& f, std::vector<float>& phase, const Vector3f& lo, const Vector3f& hi,
+             float wall) {
+  const auto outer = box(lo - Vector3f(wall, wall, wall), hi + Vector3f(wall, wall, 0));
+  const auto inner = box(lo, hi + Vector3f(0, 0, 2 * wall));
+  add_body(
+      f, phase, [=](const Vector3f& p) { return std::max(outer(p), -inner(p)); }, 2.0f * f.grid.cell);
+}
+
+// Glass shows what it holds: an ice sphere in a glass cup, seen from the side through the wall, changes
+// nearly as many pixels against the empty cup as the sphere alone covers against the background, in full
+// and in fast quality; in a cup of an opaque solid the same sphere changes none (the wall hides it). The
+// glass itself is visible: the empty cup differs from the background.
+TEST_F(RenderTest, IceInAGlassCupShowsThroughItsWalls) {
+  const Vector3f lo(-0.08f, -0.08f, -0.06f), hi(0.08f, 0.08f, 0.10f);
+  const OrbitCamera camera = centred_camera(0.7, 160, 120);  // 15 degrees up: the rim hides the inside
+  const Image bg = background(camera);
+  auto render_cup = [&](bool glass, bool ice) {
+    DensityFields f = empty_fields(Vector3f(-0.12f, -0.12f, -0.10f), Vector3f(0.12f, 0.12f, 0.12f), 64);
+    f.glass.assign(f.grid.size(), 0.0f);
+    add_cup(f, glass ? f.glass : f.solid, lo, hi, 0.015f);
+    if (ice) add_body(f, f.ice, sphere({0.0f, 0.0f, -0.01f}, 0.05f), 2.0f * f.grid.cell);
+    return renderer().render(f, camera);
+  };
+  auto changed = [&](const Image& a, const Image& b) {
+    long n = 0;
+    for (int y = 0; y < camera.height; ++y)
+      for (int x = 0; x < camera.width; ++x) n += differs(a, b, x, y, 6);
+    return n;
+  };
+  DensityFields alone = empty_fields(Vector3f(-0.12f, -0.12f, -0.10f), Vector3f(0.12f, 0.12f, 0.12f), 64);
+  add_body(alone, alone.ice, sphere({0.0f, 0.0f, -0.01f}, 0.05f), 2.0f * alone.grid.cell);
+  const long sphere_pixels = changed(bg, renderer().render(alone, camera));
+  for (const auto quality : {SurfaceRenderer::Quality::Full, SurfaceRenderer::Quality::Fast}) {
+    renderer().set_quality(quality);
+    const Image glass_empty = render_cup(true, false), glass_ice = render_cup(true, true);
+    const Image solid_empty = render_cup(false, false), solid_ice = render_cup(false, true);
+    const long through_glass = changed(glass_empty, glass_ice),
+               through_solid = changed(solid_empty, solid_ice);
+    std::printf(
+        "[ info ] %s: pixels the ice changes: in glass %ld, in an opaque cup %ld (the sphere alone "
+        "covers %ld); glass cup against the background %ld\n",
+        quality == SurfaceRenderer::Quality::Full ? "full" : "fast", through_glass, through_solid,
+        sphere_pixels, changed(bg, glass_empty));
+    EXPECT_GT(through_glass, 0.8 * double(sphere_pixels)) << "the sphere shows through the glass";
+    EXPECT_LT(through_solid, 50) << "an opaque wall hides it";
+    EXPECT_GT(changed(bg, glass_empty), 1000) << "the glass itself shows";
+  }
+  renderer().set_quality(SurfaceRenderer::Quality::Full);
 }
 
 TEST_F(RenderTest, StageTimes) {
