@@ -63,9 +63,9 @@ const float kIceF0 = 0.018;
 const float kWaterF0 = 0.020;
 const float kGlassF0 = 0.040;
 // Soda-lime glass is faintly green: clear through a wall, green along one seen edge-on.
-const vec3 kGlassAbsorption = vec3(1.6, 0.5, 1.0);
+const vec3 kGlassAbsorption = vec3(1.0, 0.3, 0.6);
 const vec3 kGlassColour = vec3(0.80, 0.88, 0.86);
-const float kGlassHaze = 0.05;
+const float kGlassHaze = 0.025;
 const int kGlassLayers = 4;   // glass surfaces a ray passes: into and out of a glass's two walls
 const int kMaxGlass = 48;     // cells through one glass wall
 
@@ -186,6 +186,7 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
   // One RGBA8 fetch per step tells the phases apart. The exit is then refined by bisection (after the
   // loop, as in first_hit): a path quantised to whole steps shows as contour bands.
   float path_ice = 0.0, path_water = 0.0, w = phase == 0 ? 1.0 : 0.0;  // w: the ice share of the medium
+  float water_in_front = -1.0;  // the water path before the ray first meets ice inside the medium
   float tb = t, tn = t;
   bool left = false;
   for (int i = 0; i < kMaxInside; ++i) {
@@ -196,6 +197,7 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
       break;
     }
     w = ph.r / (ph.r + ph.g);
+    if (water_in_front < 0.0 && w > 0.5) water_in_front = path_water;
     path_ice += (tn - tb) * w;
     path_water += (tn - tb) * (1.0 - w);
     tb = tn;
@@ -248,8 +250,17 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
   float scatter = phase == 0 ? max(1.0 - exp(-kIceScattering * li), kIceMinScatter)
                              : 1.0 - exp(-kWaterScattering * lw);
   float wrap = 0.5 + 0.5 * dot(n, u_light);
-  vec3 medium = (phase == 0 ? kIceColour : kWaterColour) * (0.45 * ambient(n) * ao + 0.65 * wrap * sh);
+  vec3 light = 0.45 * ambient(n) * ao + 0.65 * wrap * sh;
+  vec3 medium = (phase == 0 ? kIceColour : kWaterColour) * light;
   vec3 body = mix(transmitted, medium, scatter);
+  if (phase == 1 && water_in_front >= 0.0) {
+    // Ice under water: the ice scatters as ice in front of what lies behind it, and the water in front
+    // of the ice tints and veils that, so submerged ice reads as ice (in fast quality too).
+    float lf = water_in_front * u_scale;
+    vec3 ice_look = mix(back * exp(-(kIceAbsorption * li + kWaterAbsorption * (lw - lf))), kIceColour * light,
+                        max(1.0 - exp(-kIceScattering * li), kIceMinScatter));
+    body = mix(ice_look * exp(-kWaterAbsorption * lf), medium, 1.0 - exp(-kWaterScattering * lf));
+  }
 
   // Schlick's approximation of the Fresnel reflectance (Schlick 1994, "An inexpensive BRDF model for
   // physically-based rendering"), reflecting the background, plus a highlight of the key light.

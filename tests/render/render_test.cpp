@@ -428,6 +428,40 @@ TEST_F(RenderTest, IceInAGlassCupShowsThroughItsWalls) {
   renderer().set_quality(SurfaceRenderer::Quality::Full);
 }
 
+// Ice under water shows: an ice sphere wholly inside a water block changes, against the block alone, at
+// least half as many pixels as the sphere alone covers, in full and in fast quality.
+TEST_F(RenderTest, IceUnderWaterShowsThroughIt) {
+  const OrbitCamera camera = centred_camera(0.7, 160, 120);
+  const Image bg = background(camera);
+  auto render_water = [&](bool ice, bool water) {
+    DensityFields f = empty_fields(Vector3f(-0.12f, -0.12f, -0.10f), Vector3f(0.12f, 0.12f, 0.12f), 64);
+    // The water's particles make way for the ice's, as in a melt: its field is carved where the ice is.
+    const auto block = box({-0.09f, -0.09f, -0.08f}, {0.09f, 0.09f, 0.08f});
+    const auto hole = sphere({0.0f, 0.0f, 0.0f}, ice ? 0.05f : 0.0f);
+    if (water)
+      add_body(
+          f, f.water, [=](const Vector3f& p) { return ice ? std::max(block(p), -hole(p)) : block(p); },
+          2.0f * f.grid.cell);
+    if (ice) add_body(f, f.ice, sphere({0.0f, 0.0f, 0.0f}, 0.05f), 2.0f * f.grid.cell);
+    return renderer().render(f, camera);
+  };
+  auto changed = [&](const Image& a, const Image& b) {
+    long n = 0;
+    for (int y = 0; y < camera.height; ++y)
+      for (int x = 0; x < camera.width; ++x) n += differs(a, b, x, y, 6);
+    return n;
+  };
+  const long sphere_pixels = changed(bg, render_water(true, false));
+  for (const auto quality : {SurfaceRenderer::Quality::Full, SurfaceRenderer::Quality::Fast}) {
+    renderer().set_quality(quality);
+    const long under_water = changed(render_water(false, true), render_water(true, true));
+    std::printf("[ info ] %s: the ice under water changes %ld pixels (the sphere alone covers %ld)\n",
+                quality == SurfaceRenderer::Quality::Full ? "full" : "fast", under_water, sphere_pixels);
+    EXPECT_GT(under_water, sphere_pixels / 2);
+  }
+  renderer().set_quality(SurfaceRenderer::Quality::Full);
+}
+
 TEST_F(RenderTest, StageTimes) {
   const DensityFields f = scene_fields(128, true);
   std::printf("[ info ] golden scene in a %dx%dx%d field\n", f.grid.nx, f.grid.ny, f.grid.nz);
