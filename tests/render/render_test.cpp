@@ -110,6 +110,14 @@ bool differs(const Image& a, const Image& b, int x, int y, int tolerance) {
   return false;
 }
 
+// Pixels where two images of one size differ by more than `tolerance` in some channel.
+long changed_pixels(const Image& a, const Image& b, int tolerance) {
+  long n = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) n += differs(a, b, x, y, tolerance);
+  return n;
+}
+
 // Pixels that differ from the background image.
 long silhouette(const Image& image, const Image& background) {
   long count = 0;
@@ -401,12 +409,7 @@ TEST_F(RenderTest, IceInAGlassCupShowsThroughItsWalls) {
     if (ice) add_body(f, f.ice, sphere({0.0f, 0.0f, -0.01f}, 0.05f), 2.0f * f.grid.cell);
     return renderer().render(f, camera);
   };
-  auto changed = [&](const Image& a, const Image& b) {
-    long n = 0;
-    for (int y = 0; y < camera.height; ++y)
-      for (int x = 0; x < camera.width; ++x) n += differs(a, b, x, y, 6);
-    return n;
-  };
+  const auto changed = [](const Image& a, const Image& b) { return changed_pixels(a, b, 6); };
   DensityFields alone = empty_fields(Vector3f(-0.12f, -0.12f, -0.10f), Vector3f(0.12f, 0.12f, 0.12f), 64);
   add_body(alone, alone.ice, sphere({0.0f, 0.0f, -0.01f}, 0.05f), 2.0f * alone.grid.cell);
   const long sphere_pixels = changed(bg, renderer().render(alone, camera));
@@ -445,12 +448,7 @@ TEST_F(RenderTest, IceUnderWaterShowsThroughIt) {
     if (ice) add_body(f, f.ice, sphere({0.0f, 0.0f, 0.0f}, 0.05f), 2.0f * f.grid.cell);
     return renderer().render(f, camera);
   };
-  auto changed = [&](const Image& a, const Image& b) {
-    long n = 0;
-    for (int y = 0; y < camera.height; ++y)
-      for (int x = 0; x < camera.width; ++x) n += differs(a, b, x, y, 6);
-    return n;
-  };
+  const auto changed = [](const Image& a, const Image& b) { return changed_pixels(a, b, 6); };
   const long sphere_pixels = changed(bg, render_water(true, false));
   for (const auto quality : {SurfaceRenderer::Quality::Full, SurfaceRenderer::Quality::Fast}) {
     renderer().set_quality(quality);
