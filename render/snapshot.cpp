@@ -32,6 +32,10 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
       s.glass[i] = p.material[i] < scene.materials.size() && scene.materials[p.material[i]].transparent;
   }
   s.temperature = temperature;
+  for (const Dryer& d : scene.dryers)
+    s.dryers.push_back({d.position.cast<float>(), d.direction.normalized().cast<float>(),
+                        static_cast<float>(0.5 * d.nozzle_diameter), static_cast<float>(d.half_angle),
+                        static_cast<float>(d.reach), d.on});
   s.spacing = static_cast<float>(scene.spacing);
   s.domain_min = scene.domain.min.cast<float>();
   s.domain_max = scene.domain.max.cast<float>();

@@ -10,11 +10,20 @@
 
 namespace thaw {
 
+// A hair dryer as drawn: a nozzle (a short cylinder behind `position`, pointing along `direction`) and,
+// while it blows, a faint cone of its reach and half-angle, so aiming shows in the picture.
+struct DryerMarker {
+  Eigen::Vector3f position = Eigen::Vector3f::Zero(), direction = -Eigen::Vector3f::UnitZ();  // [m], unit
+  float nozzle_radius = 0.02f, half_angle = 15.0f, reach = 0.3f;                              // m, deg, m
+  bool on = true;
+};
+
 struct RenderSnapshot {
   std::vector<Eigen::Vector3f> position;  // [m]
   std::vector<std::uint8_t> phase;        // thaw::Phase
   std::vector<std::uint8_t> glass;        // 1 for a solid particle of a transparent material; empty: none
   std::vector<float> temperature;         // [°C]; empty when the scene has no heat
+  std::vector<DryerMarker> dryers;        // the scene's dryers as they are at this step
   float spacing = 0;                      // particle spacing [m]
   Eigen::Vector3f domain_min = Eigen::Vector3f::Zero(), domain_max = Eigen::Vector3f::Zero();
   Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(),

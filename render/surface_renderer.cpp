@@ -319,6 +319,25 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
   glUniform3fv(loc("u_up"), 1, u.data());
   glUniform2f(loc("u_viewport"), float(camera.width), float(camera.height));
   glUniform3fv(loc("u_light"), 1, light.data());
+  // Dryers in grid units, as the shader's rays are.
+  const int dryers = std::min<int>(int(dryers_.size()), kMaxDryers);
+  std::vector<float> pos(3 * kMaxDryers, 0.0f), dir(3 * kMaxDryers, 0.0f), shape(4 * kMaxDryers, 0.0f);
+  for (int k = 0; k < dryers; ++k) {
+    const DryerMarker& m = dryers_[std::size_t(k)];
+    const Eigen::Vector3f p = (m.position - grid_.origin) / cell;
+    for (int a = 0; a < 3; ++a) {
+      pos[3 * k + a] = p[a];
+      dir[3 * k + a] = m.direction[a];
+    }
+    shape[4 * k + 0] = m.nozzle_radius / cell;
+    shape[4 * k + 1] = float(std::tan(double(m.half_angle) * M_PI / 180.0));
+    shape[4 * k + 2] = m.reach / cell;
+    shape[4 * k + 3] = m.on ? 1.0f : 0.0f;
+  }
+  glUniform1i(loc("u_dryers"), dryers);
+  glUniform3fv(loc("u_dryer_pos"), kMaxDryers, pos.data());
+  glUniform3fv(loc("u_dryer_dir"), kMaxDryers, dir.data());
+  glUniform4fv(loc("u_dryer_shape"), kMaxDryers, shape.data());
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_3D, field_);
   glActiveTexture(GL_TEXTURE1);

@@ -26,6 +26,7 @@
 #include "render/density_field.h"
 #include "render/egl_context.h"
 #include "render/image.h"
+#include "render/snapshot.h"
 
 namespace thaw {
 
@@ -41,6 +42,9 @@ class SurfaceRenderer {
   Image render(const DensityFields& fields, const OrbitCamera& camera);
   // Draws the fields uploaded last from another camera, e.g. orbiting a paused scene (no upload).
   Image render(const OrbitCamera& camera);
+  // The dryers drawn with the next frames (at most kMaxDryers; the rest are not drawn).
+  void set_dryers(std::vector<DryerMarker> dryers) { dryers_ = std::move(dryers); }
+  static constexpr int kMaxDryers = 4;
 
   struct Times {
     double upload_ms = 0;    // CPU preparation (max field, phases, blocks) and texture upload
@@ -65,6 +69,7 @@ class SurfaceRenderer {
 
  private:
   void upload(const DensityFields& fields);
+  std::vector<DryerMarker> dryers_;
   void resize_volume(int nx, int ny, int nz);
   void resize_target(int width, int height);
 

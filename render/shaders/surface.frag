@@ -13,6 +13,8 @@
 //          passing on through the wall, tinted by Beer-Lambert along the path inside it: the ray goes on
 //          to what the glass holds, through up to kGlassLayers walls.
 // Translucent phases show what lies behind them along the straight ray (no refraction), shaded opaque.
+// Dryers are drawn over the scene: a dark nozzle, and while one blows a faint warm cone of its reach,
+// hidden behind the first opaque surface, so aiming shows.
 // Contact cues: ambient occlusion from the fields along the normal, and soft shadows from the blocks'
 // precomputed light transmittance.
 //
@@ -36,6 +38,12 @@ uniform vec3 u_eye;          // grid units
 uniform vec3 u_forward, u_right, u_up;
 uniform vec2 u_viewport;
 uniform vec3 u_light;        // unit vector toward the key light
+// Hair dryers (grid units): nozzle position, unit direction, and (nozzle radius, tan of the half-angle,
+// reach, 1 while blowing).
+uniform int u_dryers;
+uniform vec3 u_dryer_pos[4];
+uniform vec3 u_dryer_dir[4];
+uniform vec4 u_dryer_shape[4];
 
 out vec4 o_colour;
 
@@ -271,11 +279,87 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
   return mix(body, background(r), fresnel) + highlight;
 }
 
+// The nearest t > 0 where the ray meets a capped cylinder from a to b of radius r, with the outward
+// normal in n; -1 on a miss. The quadratic of the infinite cylinder, then the caps (the construction
+// of Quilez's "intersectors" capped cylinder).
+float cylinder_hit(vec3 ro, vec3 rd, vec3 a, vec3 b, float r, out vec3 n) {
+  vec3 ba = b - a, oc = ro - a;
+  float baba = dot(ba, ba), bard = dot(ba, rd), baoc = dot(ba, oc);
+  float k2 = baba - bard * bard;
+  float k1 = baba * dot(oc, rd) - baoc * bard;
+  float k0 = baba * dot(oc, oc) - baoc * baoc - r * r * baba;
+  float h = k1 * k1 - k2 * k0;
+  n = vec3(0.0);
+  if (h < 0.0 || abs(k2) < 1e-9) return -1.0;
+  h = sqrt(h);
+  float t = (-k1 - h) / k2;
+  float y = baoc + t * bard;
+  if (y > 0.0 && y < baba && t > 0.0) {
+    n = (oc + t * rd - ba * y / baba) / r;
+    return t;
+  }
+  t = ((y < 0.0 ? 0.0 : baba) - baoc) / bard;
+  if (abs(k1 + k2 * t) < h && t > 0.0) {
+    n = ba * sign(y) / sqrt(baba);
+    return t;
+  }
+  return -1.0;
+}
+
+// The dryers over `colour`, for a ray whose first opaque surface lies at t_scene.
+vec3 draw_dryers(vec3 colour, vec3 d, float t_scene) {
+  float nearest = t_scene;
+  for (int k = 0; k < 4; ++k) {
+    if (k >= u_dryers) break;
+    vec3 a = u_dryer_pos[k], dir = u_dryer_dir[k];
+    vec4 shape = u_dryer_shape[k];
+    float r = shape.x;
+    // The warm cone while blowing: its length along the ray, sampled over the cone's bounding sphere.
+    if (shape.w > 0.5) {
+      // Drawn to the end of its reach or where its axis leaves the fields' box, whichever comes first:
+      // the air goes no further than the floor.
+      vec3 dir_safe = mix(dir, vec3(1e-6), lessThan(abs(dir), vec3(1e-6)));
+      vec2 axis = clip_to_box(a, 1.0 / dir_safe);
+      float reach = axis.x <= axis.y ? min(shape.z, axis.y) : shape.z;
+      vec3 c = a + dir * (0.5 * reach);
+      float R = length(vec2(0.5 * reach, reach * shape.y + r));
+      vec3 oc = u_eye - c;
+      float b = dot(oc, d), q = dot(oc, oc) - R * R, h = b * b - q;
+      if (h > 0.0) {
+        h = sqrt(h);
+        float t0 = max(-b - h, 0.0), t1 = min(-b + h, nearest);
+        float inside = 0.0;
+        const int kSamples = 12;
+        float dt = (t1 - t0) / float(kSamples);
+        for (int i = 0; i < kSamples; ++i) {
+          vec3 x = u_eye + (t0 + (float(i) + 0.5) * dt) * d - a;
+          float along = dot(x, dir);
+          float across = length(x - along * dir);
+          inside += (along > 0.0 && along < reach && across < along * shape.y + r) ? dt : 0.0;
+        }
+        // A faint haze: at most a quarter of the way to warm orange.
+        float density = 0.8 / max(reach * shape.y + r, 1.0);
+        colour = mix(colour, vec3(1.0, 0.62, 0.3), 0.25 * (1.0 - exp(-density * max(inside, 0.0))));
+      }
+    }
+    // The nozzle: a dark cylinder one and a half radii long behind the outlet.
+    vec3 n;
+    float t = cylinder_hit(u_eye, d, a - dir * (1.5 * r), a, r, n);
+    if (t > 0.0 && t < nearest) {
+      nearest = t;
+      float lambert = max(dot(n, u_light), 0.0);
+      colour = vec3(0.16, 0.17, 0.19) * (0.5 * ambient(n) + 0.8 * lambert) +
+               0.4 * pow(max(dot(reflect(d, n), u_light), 0.0), 30.0);
+    }
+  }
+  return colour;
+}
+
 void main() {
   vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
   vec3 d = normalize(u_forward + ndc.x * u_right + ndc.y * u_up);
   if (u_has_volume == 0) {
-    o_colour = vec4(background(d), 1.0);
+    o_colour = vec4(clamp(draw_dryers(background(d), d, 1e30), 0.0, 1.0), 1.0);
     return;
   }
   // Keep 1/d finite: an axis-parallel ray would give 0 * inf = NaN at the box faces.
@@ -285,7 +369,7 @@ void main() {
 
   // Glass passes part of the light on: `through` is how much of what lies further along reaches the eye.
   vec3 colour = vec3(0.0), through = vec3(1.0);
-  float from = span.x;
+  float from = span.x, t_scene = 1e30;  // t_scene: the first opaque surface, which hides the dryers
   bool ended = false;
   for (int layer = 0; layer < kGlassLayers; ++layer) {
     float t = span.x > span.y || from >= span.y ? -1.0 : first_hit(u_eye, d, inv, from, span.y);
@@ -298,6 +382,7 @@ void main() {
     int phase = dominant(phases(p));
     vec3 n = normal_at(p, d, inv, span, t);
     if (phase != 3) {
+      t_scene = t;
       colour += through * shade(p, n, d, inv, span, t, phase);
       ended = true;
       break;
@@ -318,5 +403,5 @@ void main() {
     from = te + 0.5;  // past where the 8-bit glass field still reads near iso
   }
   if (!ended) colour += through * background(d);
-  o_colour = vec4(clamp(colour, 0.0, 1.0), 1.0);
+  o_colour = vec4(clamp(draw_dryers(colour, d, t_scene), 0.0, 1.0), 1.0);
 }

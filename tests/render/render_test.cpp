@@ -460,6 +460,37 @@ TEST_F(RenderTest, IceUnderWaterShowsThroughIt) {
   renderer().set_quality(SurfaceRenderer::Quality::Full);
 }
 
+// A dryer is drawn where it is and where it points: its nozzle changes pixels against no dryer; blowing,
+// its cone changes more; aimed elsewhere, the picture changes (the cone moved); switched off, the cone
+// goes and the nozzle stays.
+TEST_F(RenderTest, ADryerIsDrawnAndItsAimShows) {
+  const OrbitCamera camera = centred_camera(0.7, 160, 120);
+  const DensityFields f = sphere_fields(&DensityFields::ice, 0.05f, 48);
+  auto with = [&](std::vector<DryerMarker> dryers) {
+    renderer().set_dryers(std::move(dryers));
+    return renderer().render(f, camera);
+  };
+  DryerMarker dryer;
+  dryer.position = Vector3f(0.0f, 0.0f, 0.12f);
+  dryer.direction = -Vector3f::UnitZ();
+  dryer.nozzle_radius = 0.015f;
+  dryer.half_angle = 20.0f;
+  dryer.reach = 0.2f;
+  const Image none = with({}), on = with({dryer});
+  DryerMarker aside = dryer, off = dryer;
+  aside.direction = Vector3f(0.7f, 0.0f, -0.7f).normalized();
+  off.on = false;
+  const Image aimed = with({aside}), switched_off = with({off});
+  renderer().set_dryers({});
+  const long nozzle = changed_pixels(none, switched_off, 6), blowing = changed_pixels(none, on, 6);
+  const long moved = changed_pixels(on, aimed, 6);
+  std::printf("[ info ] pixels changed: the nozzle %ld, nozzle and cone %ld, aimed aside %ld\n", nozzle,
+              blowing, moved);
+  EXPECT_GT(nozzle, 30) << "a nozzle 3 cm across at 0.7 m covers about 50 pixels here";
+  EXPECT_GT(blowing, nozzle + 200);
+  EXPECT_GT(moved, 200);
+}
+
 TEST_F(RenderTest, StageTimes) {
   const DensityFields f = scene_fields(128, true);
   std::printf("[ info ] golden scene in a %dx%dx%d field\n", f.grid.nx, f.grid.ny, f.grid.nz);
