@@ -77,15 +77,17 @@ void chebyshev_distance(std::vector<std::uint8_t>& d, int nx, int ny, int nz) {
 
 SurfaceRenderer::SurfaceRenderer(EglContext& context) : context_(context) {
   glGenVertexArrays(1, &vao_);
-  program_ = program_for(quality_);
+  program_ = program_for(quality_, false, false);
 }
 
-GLuint SurfaceRenderer::program_for(Quality q) {
-  GLuint& p = programs_[q == Quality::Full ? 0 : 1];
+GLuint SurfaceRenderer::program_for(Quality q, bool glass, bool dryers) {
+  GLuint& p = programs_[(q == Quality::Full ? 0 : 1) + (glass ? 2 : 0) + (dryers ? 4 : 0)];
   if (p) return p;
   // A variant per quality: a uniform switch left the fast frame as slow as the full one on llvmpipe.
   p = build_program("fullscreen.vert", "surface.frag",
-                    std::string("#define THAW_SEE_BEHIND ") + (q == Quality::Full ? "1" : "0") + "\n");
+                    std::string("#define THAW_SEE_BEHIND ") + (q == Quality::Full ? "1" : "0") +
+                        "\n#define THAW_GLASS " + (glass ? "1" : "0") + "\n#define THAW_DRYERS " +
+                        (dryers ? "1" : "0") + "\n");
   glUseProgram(p);
   glUniform1i(glGetUniformLocation(p, "u_field"), 0);
   glUniform1i(glGetUniformLocation(p, "u_phases"), 1);
@@ -96,7 +98,7 @@ GLuint SurfaceRenderer::program_for(Quality q) {
 
 void SurfaceRenderer::set_quality(Quality q) {
   quality_ = q;
-  program_ = program_for(q);
+  program_ = program_for(q, has_glass_, !dryers_.empty());
 }
 
 SurfaceRenderer::~SurfaceRenderer() {
@@ -138,6 +140,7 @@ void SurfaceRenderer::upload(const DensityFields& f) {
     if (!v->empty() && v->size() != g.size())
       throw Error("surface renderer: a phase field holds " + std::to_string(v->size()) +
                   " values for a grid of " + std::to_string(g.size()) + " nodes");
+  has_glass_ = !f.glass.empty();
   has_volume_ = g.nx >= 2 && g.ny >= 2 && g.nz >= 2 && g.cell > 0 &&
                 !(f.ice.empty() && f.water.empty() && f.solid.empty() && f.glass.empty());
   grid_ = g;
@@ -292,6 +295,7 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
   glViewport(0, 0, camera.width, camera.height);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
+  program_ = program_for(quality_, has_glass_, !dryers_.empty());
   glUseProgram(program_);
 
   // The camera basis from the view matrix (rows: right, up, -forward), scaled so that

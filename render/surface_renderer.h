@@ -86,8 +86,11 @@ class SurfaceRenderer {
   std::vector<std::uint8_t> phase_bytes_, skip_distance_;
   Times times_;
   Quality quality_ = Quality::Full;
-  GLuint programs_[2] = {0, 0};  // per quality, built when first used
-  GLuint program_for(Quality q);
+  // A variant per quality and per what the frame has: glass, dryers (a glass or dryer branch left in
+  // the shader slowed the march of every frame by a quarter on llvmpipe). Built when first used.
+  GLuint programs_[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  GLuint program_for(Quality q, bool glass, bool dryers);
+  bool has_glass_ = false;  // the fields uploaded last have glass
 };
 
 }  // namespace thaw

@@ -50,6 +50,12 @@ out vec4 o_colour;
 #ifndef THAW_SEE_BEHIND
 #define THAW_SEE_BEHIND 1  // 1: find and shade the surface behind ice and water (SurfaceRenderer::Quality)
 #endif
+#ifndef THAW_GLASS
+#define THAW_GLASS 1  // 1: the fields have glass (SurfaceRenderer picks the variant per frame)
+#endif
+#ifndef THAW_DRYERS
+#define THAW_DRYERS 1  // 1: dryers are drawn
+#endif
 const int kMaxSteps = 1024;    // march iterations (jumps and steps)
 const int kBisections = 5;     // 1/32 cell
 const int kMaxInside = 128;    // steps through ice or water
@@ -359,7 +365,11 @@ void main() {
   vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
   vec3 d = normalize(u_forward + ndc.x * u_right + ndc.y * u_up);
   if (u_has_volume == 0) {
+#if THAW_DRYERS
     o_colour = vec4(clamp(draw_dryers(background(d), d, 1e30), 0.0, 1.0), 1.0);
+#else
+    o_colour = vec4(background(d), 1.0);
+#endif
     return;
   }
   // Keep 1/d finite: an axis-parallel ray would give 0 * inf = NaN at the box faces.
@@ -371,7 +381,12 @@ void main() {
   vec3 colour = vec3(0.0), through = vec3(1.0);
   float from = span.x, t_scene = 1e30;  // t_scene: the first opaque surface, which hides the dryers
   bool ended = false;
-  for (int layer = 0; layer < kGlassLayers; ++layer) {
+#if THAW_GLASS
+  const int kLayers = kGlassLayers;
+#else
+  const int kLayers = 1;
+#endif
+  for (int layer = 0; layer < kLayers; ++layer) {
     float t = span.x > span.y || from >= span.y ? -1.0 : first_hit(u_eye, d, inv, from, span.y);
     if (t < 0.0) {
       colour += through * background(d);
@@ -381,11 +396,14 @@ void main() {
     vec3 p = u_eye + t * d;
     int phase = dominant(phases(p));
     vec3 n = normal_at(p, d, inv, span, t);
+#if THAW_GLASS
     if (phase != 3) {
+#endif
       t_scene = t;
       colour += through * shade(p, n, d, inv, span, t, phase);
       ended = true;
       break;
+#if THAW_GLASS
     }
     // Glass: the reflection and a faint haze here; the rest goes on through the wall, to its far face.
     float f = schlick(kGlassF0, n, d);
@@ -401,7 +419,11 @@ void main() {
     }
     through *= (1.0 - f - kGlassHaze) * exp(-kGlassAbsorption * ((te - t) * u_scale));
     from = te + 0.5;  // past where the 8-bit glass field still reads near iso
+#endif
   }
   if (!ended) colour += through * background(d);
-  o_colour = vec4(clamp(draw_dryers(colour, d, t_scene), 0.0, 1.0), 1.0);
+#if THAW_DRYERS
+  colour = draw_dryers(colour, d, t_scene);
+#endif
+  o_colour = vec4(clamp(colour, 0.0, 1.0), 1.0);
 }
