@@ -240,6 +240,11 @@ async def scenario(call, js, until):
     await js("{ const s = document.getElementById('scene'); s.value = 'default'; s.dispatchEvent(new Event('change')); }")
     print("back", bool(await until("document.getElementById('scene-name').textContent === 'default' && dryers.length === 1", 60)))
     print("fresh sliders", await js(value('dryer-temp')), await js("document.getElementById('dryers').hidden"))
+    await js("{ const v = document.getElementById('view-kind'); v.value = 'slice'; v.dispatchEvent(new Event('change')); }")
+    print("bar labelled", bool(await until("!document.getElementById('bar-labels').hidden && document.getElementById('bar-top').textContent.endsWith('°C')", 20)))
+    await call("Page.captureScreenshot", format="png")
+    await js("{ const v = document.getElementById('view-kind'); v.value = 'surface'; v.dispatchEvent(new Event('change')); }")
+    print("bar hidden", bool(await until("document.getElementById('bar-labels').hidden", 20)))
     await js("document.getElementById('full-quality').click()")
     await asyncio.sleep(0.5)
     await call("Page.reload")
@@ -250,7 +255,7 @@ async def scenario(call, js, until):
   EXPECT_EQ(status, 0) << out;
   expect_lines(out, {"connected True", "welcome True", "sliders 70 0 1000", "dryer set True", "orbited 70.0",
                      "reset view 30.0", "scene changed True", "panels true false 1", "lamp toggled True",
-                     "back True", "fresh sliders 70 False", "reloaded True", "screenshot True"});
+                     "back True", "fresh sliders 70 False", "bar labelled True", "bar hidden True", "reloaded True", "screenshot True"});
   std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
   EXPECT_TRUE(served.stop()) << served.log();
 }
