@@ -36,6 +36,16 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
     s.dryers.push_back({d.position.cast<float>(), d.direction.normalized().cast<float>(),
                         static_cast<float>(0.5 * d.nozzle_diameter), static_cast<float>(d.half_angle),
                         static_cast<float>(d.reach), d.on});
+  for (const Lamp& l : scene.lamps) {
+    // The rectangle's width runs horizontally (across the normal and z) where it can, as the photon
+    // tracer lays it out (sim/heat_stage.cpp).
+    const Eigen::Vector3d n = l.normal.normalized();
+    Eigen::Vector3d u = n.cross(Eigen::Vector3d::UnitZ());
+    u = u.norm() > 1e-6 ? u.normalized() : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d v = n.cross(u);
+    s.lamps.push_back({l.centre.cast<float>(), (0.5 * l.width * u).cast<float>(),
+                       (0.5 * l.height * v).cast<float>(), static_cast<float>(l.temperature), l.on});
+  }
   s.spacing = static_cast<float>(scene.spacing);
   s.domain_min = scene.domain.min.cast<float>();
   s.domain_max = scene.domain.max.cast<float>();

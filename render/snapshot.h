@@ -18,12 +18,22 @@ struct DryerMarker {
   bool on = true;
 };
 
+// A radiant lamp as drawn: its emitting rectangle, centre +- half_u +- half_v (the axes the photon
+// tracer uses), glowing by its temperature while on, a dark panel when off or seen from behind.
+struct LampMarker {
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero(), half_u = Eigen::Vector3f::UnitX(),
+                  half_v = Eigen::Vector3f::UnitY();  // [m]
+  float temperature = 500.0f;                         // [°C]
+  bool on = true;
+};
+
 struct RenderSnapshot {
   std::vector<Eigen::Vector3f> position;  // [m]
   std::vector<std::uint8_t> phase;        // thaw::Phase
   std::vector<std::uint8_t> glass;        // 1 for a solid particle of a transparent material; empty: none
   std::vector<float> temperature;         // [°C]; empty when the scene has no heat
   std::vector<DryerMarker> dryers;        // the scene's dryers as they are at this step
+  std::vector<LampMarker> lamps;          // and its lamps
   float spacing = 0;                      // particle spacing [m]
   Eigen::Vector3f domain_min = Eigen::Vector3f::Zero(), domain_max = Eigen::Vector3f::Zero();
   Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(),

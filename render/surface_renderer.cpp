@@ -80,14 +80,14 @@ SurfaceRenderer::SurfaceRenderer(EglContext& context) : context_(context) {
   program_ = program_for(quality_, false, false);
 }
 
-GLuint SurfaceRenderer::program_for(Quality q, bool glass, bool dryers) {
-  GLuint& p = programs_[(q == Quality::Full ? 0 : 1) + (glass ? 2 : 0) + (dryers ? 4 : 0)];
+GLuint SurfaceRenderer::program_for(Quality q, bool glass, bool sources) {
+  GLuint& p = programs_[(q == Quality::Full ? 0 : 1) + (glass ? 2 : 0) + (sources ? 4 : 0)];
   if (p) return p;
   // A variant per quality: a uniform switch left the fast frame as slow as the full one on llvmpipe.
   p = build_program("fullscreen.vert", "surface.frag",
                     std::string("#define THAW_SEE_BEHIND ") + (q == Quality::Full ? "1" : "0") +
-                        "\n#define THAW_GLASS " + (glass ? "1" : "0") + "\n#define THAW_DRYERS " +
-                        (dryers ? "1" : "0") + "\n");
+                        "\n#define THAW_GLASS " + (glass ? "1" : "0") + "\n#define THAW_SOURCES " +
+                        (sources ? "1" : "0") + "\n");
   glUseProgram(p);
   glUniform1i(glGetUniformLocation(p, "u_field"), 0);
   glUniform1i(glGetUniformLocation(p, "u_phases"), 1);
@@ -98,7 +98,7 @@ GLuint SurfaceRenderer::program_for(Quality q, bool glass, bool dryers) {
 
 void SurfaceRenderer::set_quality(Quality q) {
   quality_ = q;
-  program_ = program_for(q, has_glass_, !dryers_.empty());
+  program_ = program_for(q, has_glass_, !dryers_.empty() || !lamps_.empty());
 }
 
 SurfaceRenderer::~SurfaceRenderer() {
@@ -295,7 +295,7 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
   glViewport(0, 0, camera.width, camera.height);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
-  program_ = program_for(quality_, has_glass_, !dryers_.empty());
+  program_ = program_for(quality_, has_glass_, !dryers_.empty() || !lamps_.empty());
   glUseProgram(program_);
 
   // The camera basis from the view matrix (rows: right, up, -forward), scaled so that
@@ -342,6 +342,28 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
   glUniform3fv(loc("u_dryer_pos"), kMaxDryers, pos.data());
   glUniform3fv(loc("u_dryer_dir"), kMaxDryers, dir.data());
   glUniform4fv(loc("u_dryer_shape"), kMaxDryers, shape.data());
+  // Lamps in grid units, glowing from dull red (400 °C) to yellow-white (1600 °C) while on.
+  const int lamps = std::min<int>(int(lamps_.size()), kMaxLamps);
+  std::vector<float> centre(3 * kMaxLamps, 0.0f), hu(3 * kMaxLamps, 0.0f), hv(3 * kMaxLamps, 0.0f),
+      glow(3 * kMaxLamps, 0.0f);
+  for (int k = 0; k < lamps; ++k) {
+    const LampMarker& m = lamps_[std::size_t(k)];
+    const Eigen::Vector3f c = (m.centre - grid_.origin) / cell, a = m.half_u / cell, b = m.half_v / cell;
+    const float f = std::clamp((m.temperature - 400.0f) / 1200.0f, 0.0f, 1.0f);
+    const Eigen::Vector3f g = m.on ? Eigen::Vector3f(0.6f + 0.4f * f, 0.12f + 0.73f * f, 0.05f + 0.55f * f)
+                                   : Eigen::Vector3f::Zero();
+    for (int i = 0; i < 3; ++i) {
+      centre[3 * k + i] = c[i];
+      hu[3 * k + i] = a[i];
+      hv[3 * k + i] = b[i];
+      glow[3 * k + i] = g[i];
+    }
+  }
+  glUniform1i(loc("u_lamps"), lamps);
+  glUniform3fv(loc("u_lamp_centre"), kMaxLamps, centre.data());
+  glUniform3fv(loc("u_lamp_u"), kMaxLamps, hu.data());
+  glUniform3fv(loc("u_lamp_v"), kMaxLamps, hv.data());
+  glUniform3fv(loc("u_lamp_glow"), kMaxLamps, glow.data());
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_3D, field_);
   glActiveTexture(GL_TEXTURE1);

@@ -42,9 +42,12 @@ class SurfaceRenderer {
   Image render(const DensityFields& fields, const OrbitCamera& camera);
   // Draws the fields uploaded last from another camera, e.g. orbiting a paused scene (no upload).
   Image render(const OrbitCamera& camera);
-  // The dryers drawn with the next frames (at most kMaxDryers; the rest are not drawn).
-  void set_dryers(std::vector<DryerMarker> dryers) { dryers_ = std::move(dryers); }
-  static constexpr int kMaxDryers = 4;
+  // The dryers and lamps drawn with the next frames (at most kMaxDryers and kMaxLamps of each).
+  void set_sources(std::vector<DryerMarker> dryers, std::vector<LampMarker> lamps) {
+    dryers_ = std::move(dryers);
+    lamps_ = std::move(lamps);
+  }
+  static constexpr int kMaxDryers = 4, kMaxLamps = 4;
 
   struct Times {
     double upload_ms = 0;    // CPU preparation (max field, phases, blocks) and texture upload
@@ -70,6 +73,7 @@ class SurfaceRenderer {
  private:
   void upload(const DensityFields& fields);
   std::vector<DryerMarker> dryers_;
+  std::vector<LampMarker> lamps_;
   void resize_volume(int nx, int ny, int nz);
   void resize_target(int width, int height);
 
@@ -86,10 +90,10 @@ class SurfaceRenderer {
   std::vector<std::uint8_t> phase_bytes_, skip_distance_;
   Times times_;
   Quality quality_ = Quality::Full;
-  // A variant per quality and per what the frame has: glass, dryers (a glass or dryer branch left in
+  // A variant per quality and per what the frame has: glass, dryers or lamps (a glass or dryer branch left in
   // the shader slowed the march of every frame by a quarter on llvmpipe). Built when first used.
   GLuint programs_[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-  GLuint program_for(Quality q, bool glass, bool dryers);
+  GLuint program_for(Quality q, bool glass, bool sources);
   bool has_glass_ = false;  // the fields uploaded last have glass
 };
 

@@ -171,7 +171,7 @@ Image FrameRenderer::render(const RenderSnapshot& s) {
   if (surface_) {
     const DensityFields fields = build_density_fields(s, options_.field);
     times_.field_ms = since(t0);
-    surface_->set_dryers(s.dryers);
+    surface_->set_sources(s.dryers, s.lamps);
     Image image = surface_->render(fields, camera_for(options_, s));
     const auto t = surface_->last_times();
     times_.upload_ms = t.upload_ms;

@@ -133,7 +133,7 @@ bool RenderWorker::render_one(const std::shared_ptr<const RenderSnapshot>& snaps
       }
       gl_->surface.set_quality(options.quality == "fast" ? SurfaceRenderer::Quality::Fast
                                                          : SurfaceRenderer::Quality::Full);
-      gl_->surface.set_dryers(snapshot->dryers);
+      gl_->surface.set_sources(snapshot->dryers, snapshot->lamps);
       const bool same = gl_->fields && uploaded_ == snapshot &&
                         uploaded_field_options_.max_cells == options.field.max_cells &&
                         uploaded_field_options_.iso == options.field.iso;

@@ -14,7 +14,8 @@
 //          to what the glass holds, through up to kGlassLayers walls.
 // Translucent phases show what lies behind them along the straight ray (no refraction), shaded opaque.
 // Dryers are drawn over the scene: a dark nozzle, and while one blows a faint warm cone of its reach,
-// hidden behind the first opaque surface, so aiming shows.
+// hidden behind the first opaque surface, so aiming shows. Lamps are their emitting rectangles, glowing
+// on their emitting side while on.
 // Contact cues: ambient occlusion from the fields along the normal, and soft shadows from the blocks'
 // precomputed light transmittance.
 //
@@ -44,6 +45,12 @@ uniform int u_dryers;
 uniform vec3 u_dryer_pos[4];
 uniform vec3 u_dryer_dir[4];
 uniform vec4 u_dryer_shape[4];
+// Lamps (grid units): the emitting rectangle's centre and half-axes, and its glow (0 when off).
+uniform int u_lamps;
+uniform vec3 u_lamp_centre[4];
+uniform vec3 u_lamp_u[4];
+uniform vec3 u_lamp_v[4];
+uniform vec3 u_lamp_glow[4];
 
 out vec4 o_colour;
 
@@ -53,8 +60,8 @@ out vec4 o_colour;
 #ifndef THAW_GLASS
 #define THAW_GLASS 1  // 1: the fields have glass (SurfaceRenderer picks the variant per frame)
 #endif
-#ifndef THAW_DRYERS
-#define THAW_DRYERS 1  // 1: dryers are drawn
+#ifndef THAW_SOURCES
+#define THAW_SOURCES 1  // 1: dryers and lamps are drawn
 #endif
 const int kMaxSteps = 1024;    // march iterations (jumps and steps)
 const int kBisections = 5;     // 1/32 cell
@@ -358,6 +365,23 @@ vec3 draw_dryers(vec3 colour, vec3 d, float t_scene) {
                0.4 * pow(max(dot(reflect(d, n), u_light), 0.0), 30.0);
     }
   }
+  // Lamps: the rectangle centre +- u +- v, nearer than anything drawn so far.
+  for (int k = 0; k < 4; ++k) {
+    if (k >= u_lamps) break;
+    vec3 c = u_lamp_centre[k], hu = u_lamp_u[k], hv = u_lamp_v[k];
+    vec3 n = normalize(cross(hu, hv));
+    float facing = dot(d, n);
+    if (abs(facing) < 1e-6) continue;
+    float t = dot(c - u_eye, n) / facing;
+    if (t <= 0.0 || t >= nearest) continue;
+    vec3 q = u_eye + t * d - c;
+    if (abs(dot(q, hu)) > dot(hu, hu) || abs(dot(q, hv)) > dot(hv, hv)) continue;
+    nearest = t;
+    // cross(u, v) is the lamp's normal, out of its emitting side (sim/heat_stage.cpp lays u, v out so):
+    // a ray against it sees the glowing face.
+    bool front = facing < 0.0;
+    colour = front && length(u_lamp_glow[k]) > 0.0 ? u_lamp_glow[k] : vec3(0.14, 0.14, 0.15);
+  }
   return colour;
 }
 
@@ -365,7 +389,7 @@ void main() {
   vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;
   vec3 d = normalize(u_forward + ndc.x * u_right + ndc.y * u_up);
   if (u_has_volume == 0) {
-#if THAW_DRYERS
+#if THAW_SOURCES
     o_colour = vec4(clamp(draw_dryers(background(d), d, 1e30), 0.0, 1.0), 1.0);
 #else
     o_colour = vec4(background(d), 1.0);
@@ -422,7 +446,7 @@ void main() {
 #endif
   }
   if (!ended) colour += through * background(d);
-#if THAW_DRYERS
+#if THAW_SOURCES
   colour = draw_dryers(colour, d, t_scene);
 #endif
   o_colour = vec4(clamp(colour, 0.0, 1.0), 1.0);

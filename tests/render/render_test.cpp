@@ -467,7 +467,7 @@ TEST_F(RenderTest, ADryerIsDrawnAndItsAimShows) {
   const OrbitCamera camera = centred_camera(0.7, 160, 120);
   const DensityFields f = sphere_fields(&DensityFields::ice, 0.05f, 48);
   auto with = [&](std::vector<DryerMarker> dryers) {
-    renderer().set_dryers(std::move(dryers));
+    renderer().set_sources(std::move(dryers), {});
     return renderer().render(f, camera);
   };
   DryerMarker dryer;
@@ -481,7 +481,7 @@ TEST_F(RenderTest, ADryerIsDrawnAndItsAimShows) {
   aside.direction = Vector3f(0.7f, 0.0f, -0.7f).normalized();
   off.on = false;
   const Image aimed = with({aside}), switched_off = with({off});
-  renderer().set_dryers({});
+  renderer().set_sources({}, {});
   const long nozzle = changed_pixels(none, switched_off, 6), blowing = changed_pixels(none, on, 6);
   const long moved = changed_pixels(on, aimed, 6);
   std::printf("[ info ] pixels changed: the nozzle %ld, nozzle and cone %ld, aimed aside %ld\n", nozzle,
@@ -489,6 +489,42 @@ TEST_F(RenderTest, ADryerIsDrawnAndItsAimShows) {
   EXPECT_GT(nozzle, 30) << "a nozzle 3 cm across at 0.7 m covers about 50 pixels here";
   EXPECT_GT(blowing, nozzle + 200);
   EXPECT_GT(moved, 200);
+}
+
+// A lamp is drawn as its rectangle: glowing warm on its emitting side while on, a dark panel when off
+// or seen from behind.
+TEST_F(RenderTest, ALampGlowsOnItsEmittingSide) {
+  const OrbitCamera camera = centred_camera(0.7, 160, 120);  // looks from +x (azimuth 20) at the origin
+  const DensityFields f = sphere_fields(&DensityFields::ice, 0.05f, 48);
+  LampMarker lamp;
+  lamp.centre = Vector3f(0.0f, 0.0f, 0.12f);
+  lamp.half_u = Vector3f(0.0f, 0.06f, 0.0f);  // cross(u, v) = +x: it faces the camera
+  lamp.half_v = Vector3f(0.0f, 0.0f, 0.03f);
+  lamp.temperature = 900.0f;
+  auto mean_rgb = [&](const LampMarker& l) {
+    renderer().set_sources({}, {l});
+    const Image image = renderer().render(f, camera);
+    const Image none = (renderer().set_sources({}, {}), renderer().render(f, camera));
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    long n = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        if (differs(image, none, x, y, 6)) {
+          for (int c = 0; c < 3; ++c) sum[c] += image.pixel(x, y)[c];
+          ++n;
+        }
+    EXPECT_GT(n, 100) << "the lamp covers pixels";
+    return Eigen::Vector3d(sum / double(std::max(n, 1L)));
+  };
+  LampMarker off = lamp, behind = lamp;
+  off.on = false;
+  behind.half_u = -lamp.half_u;  // now it faces away
+  const Eigen::Vector3d glowing = mean_rgb(lamp), dark = mean_rgb(off), back = mean_rgb(behind);
+  std::printf("[ info ] lamp mean RGB: on %.0f %.0f %.0f, off %.0f %.0f %.0f, from behind %.0f %.0f %.0f\n",
+              glowing[0], glowing[1], glowing[2], dark[0], dark[1], dark[2], back[0], back[1], back[2]);
+  EXPECT_GT(glowing[0], glowing[2] + 60) << "warm";
+  EXPECT_GT(glowing[0], dark[0] + 100);
+  EXPECT_LT(back.norm(), 80.0) << "the back of a lamp is its dark housing";
 }
 
 TEST_F(RenderTest, StageTimes) {
