@@ -45,6 +45,12 @@ Json dryers_json(const Scene& s) {
   return out;
 }
 
+Json lamps_json(const Scene& s) {
+  Json out = Json::array();
+  for (const Lamp& l : s.lamps) out.push_back(to_json(l));
+  return out;
+}
+
 // Each tap as the scene file would say it, with its volume flow in L/s beside the exit speed.
 Json emitters_json(const Scene& s) {
   Json out = Json::array();
@@ -74,12 +80,10 @@ Json Service::scene_state() const {
   const auto scene = session_.scene();
   const auto stats = session_.latest_stats();
   const RenderOptions o = renderer_.options();
-  Json lamps = Json::array();
-  for (const Lamp& l : scene->lamps) lamps.push_back(to_json(l));
   return {{"scene", scene->name},
           {"description", scene->description},
           {"dryers", dryers_json(*scene)},
-          {"lamps", lamps},
+          {"lamps", lamps_json(*scene)},
           {"emitters", emitters_json(*scene)},
           {"view", view_json(o)},
           {"quality", quality_json()},
@@ -284,9 +288,7 @@ void Service::on_published() {
   const auto scene = session_.scene();
   s["dryers"] = dryers_json(*scene);
   s["emitters"] = emitters_json(*scene);
-  Json lamps = Json::array();
-  for (const Lamp& l : scene->lamps) lamps.push_back(to_json(l));
-  s["lamps"] = std::move(lamps);
+  s["lamps"] = lamps_json(*scene);
   const RenderOptions o = renderer_.options();
   s["view"] = view_json(o);
   s["quality"] = {{"surface", o.quality}, {"width", o.width}, {"height", o.height}};

@@ -20,8 +20,15 @@ std::vector<Eigen::Vector2i> EmitterStage::disc(double radius, double spacing) {
   return out;
 }
 
+namespace {
+// N dx^3 / (pi r^2) for a disc of N lattice points.
+double spacing_of(std::size_t points, const Emitter& e, double dx) {
+  return double(points) * dx * dx * dx / e.area();
+}
+}  // namespace
+
 double EmitterStage::disc_spacing(const Emitter& e, double spacing) {
-  return double(disc(e.radius, spacing).size()) * spacing * spacing * spacing / e.area();
+  return spacing_of(disc(e.radius, spacing).size(), e, spacing);
 }
 
 double EmitterStage::particles_per_second(const Emitter& e, double spacing) {
@@ -38,9 +45,9 @@ HostParticles EmitterStage::emit(double t, double dt, std::uint32_t& next_id) {
     const double open_for = std::min(t + dt, stop) - std::max(t, e.start);
     if (!e.open || !(open_for > 0)) continue;
     pending_[k] += e.speed * open_for;
-    const double d = disc_spacing(e, dx);
+    const std::vector<Eigen::Vector2i> offsets = disc(e.radius, dx);  // once a step: a client may resize it
+    const double d = spacing_of(offsets.size(), e, dx);
     if (pending_[k] < d) continue;
-    const std::vector<Eigen::Vector2i> offsets = disc(e.radius, dx);
     const Eigen::Vector3d u = e.direction.unitOrthogonal(), w = e.direction.cross(u);
     const Material& m = scene_.materials[static_cast<std::size_t>(e.material)];
     const float mass = static_cast<float>(m.density * dx * dx * dx);

@@ -126,28 +126,24 @@ function applyView(view, quality) {
   if (quality && quality.surface) $('full-quality').checked = quality.surface === 'full';
 }
 
-// The speed select offers the server's factor even when another client chose one not in the list.
+// A menu shows the server's value, adding it as an option when another client chose one not listed;
+// the menu being used keeps the user's choice.
+function showChoice(id, value, label) {
+  const select = $(id);
+  if (value === undefined || document.activeElement === select) return;
+  const v = String(value);
+  if (![...select.options].some((o) => o.value === v)) {
+    const o = document.createElement('option');
+    o.value = v;
+    o.textContent = label(v);
+    select.appendChild(o);
+  }
+  select.value = v;
+}
+
 function applyPace(speed, heatScale) {
-  if (speed !== undefined && document.activeElement !== $('speed')) {
-    const value = String(speed);
-    if (![...$('speed').options].some((o) => o.value === value)) {
-      const o = document.createElement('option');
-      o.value = value;
-      o.textContent = `${value} × real time`;
-      $('speed').appendChild(o);
-    }
-    $('speed').value = value;
-  }
-  if (heatScale !== undefined && document.activeElement !== $('heat-scale')) {
-    const value = String(heatScale);
-    if (![...$('heat-scale').options].some((o) => o.value === value)) {
-      const o = document.createElement('option');
-      o.value = value;
-      o.textContent = `× ${value}`;
-      $('heat-scale').appendChild(o);
-    }
-    $('heat-scale').value = value;
-  }
+  showChoice('speed', speed, (v) => `${v} × real time`);
+  showChoice('heat-scale', heatScale, (v) => `× ${v}`);
 }
 
 function applyPaused(p) {
