@@ -50,14 +50,16 @@ Json bench_render(const RenderBenchOptions& o, bool print) {
   Json rows = Json::array();
   if (print) {
     std::printf("renderer: %s, quality %s\n", gl.description().c_str(), o.fast ? "fast" : "full");
-    std::printf("%-9s %-10s %8s %8s %8s %9s %8s %8s | %10s\n", "particles", "image", "field", "upload", "march",
-                "readback", "jpeg", "total", "cpu march");
+    std::printf("%-9s %-10s %5s %8s %8s %8s %9s %8s %8s | %10s\n", "particles", "image", "scale", "field", "upload",
+                "march", "readback", "jpeg", "total", "cpu march");
   }
   for (std::size_t n : o.sizes) {
     const RenderSnapshot snap = bench_snapshot(n);
     FieldOptions fo;
     fo.max_cells = o.field_cells;
-    for (const auto& [w, h] : o.resolutions) {
+    for (const auto& [w, h] : o.resolutions)
+    for (const double scale : o.scales) {
+      renderer.set_scale(scale);
       OrbitCamera cam = OrbitCamera::framing(snap.domain_min.cast<double>(), snap.domain_max.cast<double>(), 30, 25,
                                              w, h);
       double field = 1e300, upload = 1e300, march = 1e300, readback = 1e300, jpeg = 1e300, total = 1e300;
@@ -85,7 +87,7 @@ Json bench_render(const RenderBenchOptions& o, bool print) {
       // The reference: the same surface search on the CPU, one pick per pixel (single thread, no
       // shading), at the smallest image only: it is slow by design.
       double cpu = -1;
-      if (w == o.resolutions.front().first && h == o.resolutions.front().second) {
+      if (w == o.resolutions.front().first && h == o.resolutions.front().second && scale == o.scales.front()) {
         const auto t0 = Clock::now();
         long hits = 0;
         for (int y = 0; y < h; ++y)
@@ -99,6 +101,7 @@ Json bench_render(const RenderBenchOptions& o, bool print) {
       Json row = {{"particles", snap.position.size()},
                   {"width", w},
                   {"height", h},
+                  {"scale", scale},
                   {"field_grid", {fields.grid.nx, fields.grid.ny, fields.grid.nz}},
                   {"field_ms", field},
                   {"upload_ms", upload},
@@ -114,15 +117,15 @@ Json bench_render(const RenderBenchOptions& o, bool print) {
         std::snprintf(image, sizeof image, "%dx%d", w, h);
         char reference[32] = "";
         if (cpu >= 0) std::snprintf(reference, sizeof reference, "%10.2f", cpu);
-        std::printf("%-9zu %-10s %8.2f %8.2f %8.2f %9.2f %8.2f %8.2f | %10s\n", snap.position.size(), image, field,
-                    upload, march, readback, jpeg, total, reference);
+        std::printf("%-9zu %-10s %5.2f %8.2f %8.2f %8.2f %9.2f %8.2f %8.2f | %10s\n", snap.position.size(), image,
+                    scale, field, upload, march, readback, jpeg, total, reference);
       }
       std::fflush(stdout);
     }
   }
   if (print)
     std::printf("(field: metaball fields on the CPU; upload: max field, phases, blocks, textures; march: the GL draw "
-                "to completion;\n readback: glReadPixels; jpeg: libturbojpeg q80; cpu march: one CPU pick per pixel, "
+                "to completion;\n scale: the fraction of width and height marched; readback: the stretch below 1, glReadPixels; jpeg: libturbojpeg q80; cpu march: one CPU pick per pixel, "
                 "single thread, the reference)\n");
   out["runs"] = rows;
   return out;

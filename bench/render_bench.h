@@ -13,6 +13,7 @@ struct RenderBenchOptions {
   int frames = 5;         // timed frames per case, after one untimed; the fastest is reported
   int field_cells = 128;  // FieldOptions::max_cells
   bool fast = false;      // SurfaceRenderer::Quality::Fast
+  std::vector<double> scales = {1.0};  // SurfaceRenderer::set_scale, each against the first in the same run
 };
 
 // Sizes are particles of ice and water: a block of water with an ice cube standing in it.

@@ -104,8 +104,10 @@ void SurfaceRenderer::set_quality(Quality q) {
 SurfaceRenderer::~SurfaceRenderer() {
   for (GLuint t : {field_, phases_, blocks_})
     if (t) glDeleteTextures(1, &t);
-  if (colour_) glDeleteRenderbuffers(1, &colour_);
-  if (fbo_) glDeleteFramebuffers(1, &fbo_);
+  for (GLuint r : {colour_, marched_colour_})
+    if (r) glDeleteRenderbuffers(1, &r);
+  for (GLuint f : {fbo_, marched_fbo_})
+    if (f) glDeleteFramebuffers(1, &f);
   if (vao_) glDeleteVertexArrays(1, &vao_);
   for (GLuint p : programs_)
     if (p) glDeleteProgram(p);
@@ -262,22 +264,49 @@ void SurfaceRenderer::upload(const DensityFields& f) {
   times_.upload_ms = ms_since(t0);
 }
 
-void SurfaceRenderer::resize_target(int width, int height) {
-  if (width == width_ && height == height_) return;
-  if (!fbo_) glGenFramebuffers(1, &fbo_);
-  if (colour_) glDeleteRenderbuffers(1, &colour_);
-  glGenRenderbuffers(1, &colour_);
-  glBindRenderbuffer(GL_RENDERBUFFER, colour_);
+namespace {
+
+// An RGBA8 renderbuffer of width x height attached to `fbo` (both made when 0), replacing `colour`.
+void make_target(GLuint& fbo, GLuint& colour, int width, int height) {
+  if (!fbo) glGenFramebuffers(1, &fbo);
+  if (colour) glDeleteRenderbuffers(1, &colour);
+  glGenRenderbuffers(1, &colour);
+  glBindRenderbuffer(GL_RENDERBUFFER, colour);
   glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour);
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
     throw Error("surface renderer: the " + std::to_string(width) + "x" + std::to_string(height) +
                 " RGBA8 framebuffer is incomplete (glCheckFramebufferStatus " + std::to_string(status) + ")");
   check_gl("allocating the framebuffer");
+}
+
+}  // namespace
+
+void SurfaceRenderer::resize_target(int width, int height) {
+  if (width == width_ && height == height_) return;
+  make_target(fbo_, colour_, width, height);
   width_ = width;
   height_ = height;
+}
+
+void SurfaceRenderer::resize_marched(int width, int height) {
+  if (width == marched_width_ && height == marched_height_) return;
+  make_target(marched_fbo_, marched_colour_, width, height);
+  marched_width_ = width;
+  marched_height_ = height;
+}
+
+void SurfaceRenderer::set_scale(double scale) {
+  if (!(scale >= kMinScale && scale <= 1.0))
+    throw Error("surface renderer: scale " + std::to_string(scale) + " is outside " + std::to_string(kMinScale) +
+                "..1");
+  scale_ = scale;
+}
+
+int SurfaceRenderer::marched(int pixels, double scale) {
+  return std::clamp(static_cast<int>(std::lround(pixels * scale)), 1, pixels);
 }
 
 Image SurfaceRenderer::render(const DensityFields& fields, const OrbitCamera& camera) {
@@ -291,8 +320,11 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
                 std::to_string(camera.height) + " is empty");
   const auto t0 = Clock::now();
   resize_target(camera.width, camera.height);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  glViewport(0, 0, camera.width, camera.height);
+  const int mw = marched(camera.width, scale_), mh = marched(camera.height, scale_);
+  const bool reduced = mw < camera.width || mh < camera.height;
+  if (reduced) resize_marched(mw, mh);
+  glBindFramebuffer(GL_FRAMEBUFFER, reduced ? marched_fbo_ : fbo_);
+  glViewport(0, 0, mw, mh);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
   program_ = program_for(quality_, has_glass_, !dryers_.empty() || !lamps_.empty());
@@ -321,7 +353,7 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
   const Eigen::Vector3f r = right * (tan_half * aspect), u = up * tan_half;
   glUniform3fv(loc("u_right"), 1, r.data());
   glUniform3fv(loc("u_up"), 1, u.data());
-  glUniform2f(loc("u_viewport"), float(camera.width), float(camera.height));
+  glUniform2f(loc("u_viewport"), float(mw), float(mh));
   glUniform3fv(loc("u_light"), 1, light.data());
   // Dryers in grid units, as the shader's rays are.
   const int dryers = std::min<int>(int(dryers_.size()), kMaxDryers);
@@ -377,6 +409,13 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
   times_.march_ms = ms_since(t0);
 
   const auto t1 = Clock::now();
+  if (reduced) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, marched_fbo_);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo_);
+    glBlitFramebuffer(0, 0, mw, mh, 0, 0, camera.width, camera.height, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    check_gl("stretching the reduced frame");
+  }
   Image image(camera.width, camera.height);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, camera.width, camera.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());

@@ -9,6 +9,7 @@
 #include "bench/bodies_bench.h"
 #include "bench/render_bench.h"
 #include "bench/throughput.h"
+#include "render/surface_renderer.h"
 #include "server/cli_args.h"
 #include "server/commands.h"
 #include "sim/error.h"
@@ -61,8 +62,12 @@ int cmd_bench(int argc, char** argv) {
     return 0;
   }
   if (kind == "render") {
-    CliArgs args(argc, argv, 3, {"--sizes", "--frames", "--field-cells", "--quality"}, {"--json"});
+    CliArgs args(argc, argv, 3, {"--sizes", "--frames", "--field-cells", "--quality", "--scales"},
+                 {"--json"});
     RenderBenchOptions o;
+    if (auto s = args.value("--scales")) o.scales = list_of<double>(*s, "--scales");
+    for (const double s : o.scales)
+      if (!(s >= SurfaceRenderer::kMinScale && s <= 1.0)) throw Error("--scales: each must be 0.25..1");
     if (auto s = args.value("--sizes")) o.sizes = list_of<std::size_t>(*s, "--sizes");
     o.frames = static_cast<int>(args.integer("--frames", o.frames));
     if (o.frames < 1) throw Error("--frames: must be >= 1");

@@ -31,7 +31,8 @@ constexpr CommandHelp kCommands[] = {
     {"bench",
      "  bench throughput µs per particle-step per stage, with a hand-written reference loop (--json)\n"
      "  bench accuracy CASE  error against run time over resolutions (--res 10,15,20 --out DIR)\n"
-     "  bench render     ms per frame by stage (field, upload, march, read-back, JPEG) (--sizes, --json)\n"
+     "  bench render     ms per frame by stage (field, upload, march, read-back, JPEG) (--sizes, --quality,\n"
+     "                   --scales 1,0.75,0.5, --json)\n"
      "  bench bodies     ice labelling and per-body sums against union-find and a plain loop (--size, "
      "--json)\n"},
     {"render",

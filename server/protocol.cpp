@@ -310,6 +310,7 @@ void read_quality_set(QualitySet& c, const Json& v) {
   c.jpeg_quality = opt<int>(v, "jpeg_quality");
   c.fps = opt<double>(v, "fps");
   c.surface = opt<std::string>(v, "surface");
+  c.scale = opt<double>(v, "scale");
 }
 
 std::vector<Spec> build_specs() {
@@ -378,7 +379,11 @@ std::vector<Spec> build_specs() {
                        integer("height", "Image height").in("px").at_least(16).at_most(1080).optional(),
                        integer("jpeg_quality", "JPEG quality").at_least(10).at_most(95).optional(),
                        number("fps", "Frame-rate cap").in("1/s").at_least(1).at_most(60).optional(),
-                       choice("surface", {"full", "fast"}, "Surface reconstruction quality").optional()},
+                       choice("surface", {"full", "fast"}, "Surface reconstruction quality").optional(),
+                       number("scale", "Fraction of width and height the surface march draws, stretched to the image")
+                           .at_least(0.25)
+                           .at_most(1)
+                           .optional()},
                       read_quality_set));
   rows.push_back(
       row<StateSave>("state.save", {text("name", "A file in the server's state folder")}, read_state_save));

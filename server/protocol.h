@@ -91,6 +91,7 @@ struct QualitySet {
   std::optional<int> jpeg_quality;     // 10 .. 95
   std::optional<double> fps;           // frame cap, 1 .. 60
   std::optional<std::string> surface;  // full | fast
+  std::optional<double> scale;         // surface: the fraction of width and height the march draws
 };
 struct StateSave {
   std::string name;  // [A-Za-z0-9_-]{1,64}: a file in the server's state folder, never a path

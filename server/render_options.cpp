@@ -158,6 +158,7 @@ FrameRenderer::FrameRenderer(RenderOptions options) : options_(std::move(options
     surface_ = std::make_unique<SurfaceRenderer>(*gl_);
     surface_->set_quality(options_.quality == "fast" ? SurfaceRenderer::Quality::Fast
                                                      : SurfaceRenderer::Quality::Full);
+    surface_->set_scale(options_.scale);
   }
 }
 

@@ -19,6 +19,7 @@ struct RenderOptions {
   std::string view = "surface";     // surface | particles | slice
   std::string colour_by = "phase";  // particles: phase | temperature
   std::string quality = "full";     // surface: full | fast (SurfaceRenderer::Quality)
+  double scale = 1.0;               // surface: the fraction of width and height marched (SurfaceRenderer)
   int slice_axis = 1;               // slice: the plane's normal axis
   double slice_position = 0.5;      // slice: fraction of the domain along it
   int width = 640, height = 480;

@@ -22,10 +22,15 @@ double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-// Frames a second the pixel budget allows for frames drawn with `o` (RenderWorker::fps_limit).
+// Frames a second the pixel budget allows for frames drawn with `o` (RenderWorker::fps_limit): the
+// surface view marches scale^2 of the pixels.
 double budget_fps(const RenderOptions& o) {
-  const double weight = o.view == "surface" && o.quality == "full" ? RenderWorker::kFullQualityWeight : 1.0;
-  return RenderWorker::kMaxPixelsPerSecond / (double(o.width) * o.height * weight);
+  const bool surface = o.view == "surface";
+  const double weight = surface && o.quality == "full" ? RenderWorker::kFullQualityWeight : 1.0;
+  const double marched = surface ? double(SurfaceRenderer::marched(o.width, o.scale)) *
+                                       SurfaceRenderer::marched(o.height, o.scale)
+                                 : double(o.width) * o.height;
+  return RenderWorker::kMaxPixelsPerSecond / (marched * weight);
 }
 
 Clock::duration seconds(double s) {
@@ -82,12 +87,22 @@ void RenderWorker::run() {
     RenderOptions options;
     int quality = 80;
     double fps = 30;
+    bool moving = false;
     {
       std::unique_lock lock(mutex_);
-      cv_.wait(lock, [&] {
-        return stop_ ||
-               ((snapshot_pending_ || options_version_ != drawn_version) && (watched_ || frames_ == 0));
-      });
+      const auto settle_at = [&] { return moved_at_ + seconds(kSettleSeconds); };
+      const auto ready = [&] {
+        const bool settled = settle_due_ && Clock::now() >= settle_at();
+        return stop_ || ((snapshot_pending_ || options_version_ != drawn_version || settled) &&
+                         (watched_ || frames_ == 0));
+      };
+      // A frame drawn while the camera moved is followed by one at the chosen scale once it stops.
+      while (!ready()) {
+        if (settle_due_)
+          cv_.wait_until(lock, settle_at());
+        else
+          cv_.wait(lock);
+      }
       // The fps cap: changes that arrive meanwhile merge into the next frame instead of queueing.
       if (!stop_ && Clock::now() < next_budget) cv_.wait_until(lock, next_budget, [&] { return stop_; });
       if (!stop_ && !hurry_ && Clock::now() < next_allowed)
@@ -99,20 +114,23 @@ void RenderWorker::run() {
       options = options_;
       quality = jpeg_quality_;
       fps = std::min(fps_, budget_fps(options_));
+      moving = options.view == "surface" && options.scale > kMovingScale && Clock::now() < settle_at();
+      settle_due_ = moving;
     }
+    if (moving) options.scale = kMovingScale;
     const auto started = Clock::now();
     next_allowed = started + seconds(1.0 / fps);
     // hurry() skips the frame-rate cap, not the pixel budget: commands at 50 a second must not turn
     // into 50 large frames a second.
     next_budget = started + seconds(1.0 / budget_fps(options));
-    if (auto snapshot = session_.latest_snapshot()) render_one(snapshot, options, quality);
+    if (auto snapshot = session_.latest_snapshot()) render_one(snapshot, options, quality, moving);
   }
   // The context belongs to this thread: release it here, not in the destructor's thread.
   gl_.reset();
 }
 
 bool RenderWorker::render_one(const std::shared_ptr<const RenderSnapshot>& snapshot,
-                              const RenderOptions& options, int jpeg_quality) {
+                              const RenderOptions& options, int jpeg_quality, bool moving) {
   const auto t0 = Clock::now();
   try {
     const OrbitCamera camera = camera_for(options, *snapshot);
@@ -134,6 +152,7 @@ bool RenderWorker::render_one(const std::shared_ptr<const RenderSnapshot>& snaps
       gl_->surface.set_quality(options.quality == "fast" ? SurfaceRenderer::Quality::Fast
                                                          : SurfaceRenderer::Quality::Full);
       gl_->surface.set_sources(snapshot->dryers, snapshot->lamps);
+      gl_->surface.set_scale(options.scale);
       const bool same = gl_->fields && uploaded_ == snapshot &&
                         uploaded_field_options_.max_cells == options.field.max_cells &&
                         uploaded_field_options_.iso == options.field.iso;
@@ -159,6 +178,8 @@ bool RenderWorker::render_one(const std::shared_ptr<const RenderSnapshot>& snaps
     frame->jpeg = encode_jpeg(image, jpeg_quality);
     frame->encode_ms = ms_since(t1);
     frame->render_ms = render_ms;
+    frame->scale = options.view == "surface" ? options.scale : 1.0;
+    frame->moving = moving;
     frame->frame = ++frames_;
     frame->sim_time = snapshot->time;
     frame->step = snapshot->step;
@@ -230,6 +251,7 @@ void RenderWorker::set_camera(std::optional<double> azimuth, std::optional<doubl
     }
     if (fov) options_.fov = *fov;
     ++options_version_;
+    moved_at_ = Clock::now();
   }
   cv_.notify_all();
 }
@@ -262,6 +284,7 @@ void RenderWorker::orbit(double d_azimuth, double d_elevation, double zoom) {
     if (zoom != 1.0 && drawn > 0)
       options_.distance = std::clamp(drawn * zoom, kClosest * framing, kFarthest * framing);
     ++options_version_;
+    moved_at_ = Clock::now();
   }
   cv_.notify_all();
 }
@@ -282,7 +305,7 @@ void RenderWorker::set_view(const std::string& view, std::optional<std::string> 
 
 void RenderWorker::set_quality(std::optional<int> width, std::optional<int> height,
                                std::optional<int> jpeg_quality, std::optional<double> fps,
-                               std::optional<std::string> surface) {
+                               std::optional<std::string> surface, std::optional<double> scale) {
   if (width && (*width < 16 || *width > 1920)) throw Error("quality: width must be 16..1920 pixels");
   if (height && (*height < 16 || *height > 1080)) throw Error("quality: height must be 16..1080 pixels");
   if (jpeg_quality && (*jpeg_quality < 10 || *jpeg_quality > 95))
@@ -290,6 +313,8 @@ void RenderWorker::set_quality(std::optional<int> width, std::optional<int> heig
   if (fps && !(*fps >= 1 && *fps <= 60)) throw Error("quality: fps must be 1..60");
   if (surface && *surface != "full" && *surface != "fast")
     throw Error("quality: surface must be full or fast");
+  if (scale && !(*scale >= SurfaceRenderer::kMinScale && *scale <= 1.0))
+    throw Error("quality: scale must be 0.25..1 (the fraction of width and height the surface march draws)");
   {
     std::lock_guard lock(mutex_);
     if (width) options_.width = *width;
@@ -297,6 +322,7 @@ void RenderWorker::set_quality(std::optional<int> width, std::optional<int> heig
     if (jpeg_quality) jpeg_quality_ = *jpeg_quality;
     if (fps) fps_ = *fps;
     if (surface) options_.quality = *surface;
+    if (scale) options_.scale = *scale;
     ++options_version_;
   }
   cv_.notify_all();

@@ -37,6 +37,8 @@ struct EncodedFrame {
   int width = 0, height = 0;
   std::string jpeg;
   double render_ms = 0;  // drawing, read-back included
+  double scale = 1.0;    // the fraction of width and height the surface march drew (1: every pixel)
+  bool moving = false;   // drawn while the camera moved, at kMovingScale
   double encode_ms = 0;
 };
 
@@ -64,18 +66,26 @@ class RenderWorker {
   void orbit(double d_azimuth, double d_elevation, double zoom);
   // view: surface | particles | slice; colour_by: phase | temperature.
   void set_view(const std::string& view, std::optional<std::string> colour_by = {});
-  // width 16..1920, height 16..1080, jpeg_quality 10..95, fps cap 1..60, surface full | fast.
+  // width 16..1920, height 16..1080, jpeg_quality 10..95, fps cap 1..60, surface full | fast, scale
+  // SurfaceRenderer::kMinScale..1.
   void set_quality(std::optional<int> width, std::optional<int> height, std::optional<int> jpeg_quality,
-                   std::optional<double> fps, std::optional<std::string> surface);
+                   std::optional<double> fps, std::optional<std::string> surface,
+                   std::optional<double> scale = {});
   RenderOptions options() const;
   int jpeg_quality() const;
   double fps_cap() const;  // as asked for with set_quality
   // The frame rate the worker draws at most: fps_cap(), lowered so that the pixels drawn a second stay
   // within kMaxPixelsPerSecond (full-quality surfaces weigh kFullQualityWeight: measured on llvmpipe,
-  // 67 ms against 43 for fast at 640x480, 353 against 269 at 1920x1080). The default 640x480 at 12
-  // frames a second is 3.7 Mpx/s fast, 5.5 full; 1920x1080 at full quality is held to 1.9 frames a second.
+  // 67 ms against 43 for fast at 640x480, 353 against 269 at 1920x1080); the surface view counts the
+  // pixels its march draws (scale squared). The service's 640x480 fast frame marched at 3/4 is 2.6 Mpx/s
+  // at the default 15 frames a second; every pixel at full quality is held to 13 frames a second, and
+  // 1920x1080 at full quality to 1.9.
   double fps_limit() const;
   static constexpr double kMaxPixelsPerSecond = 6e6, kFullQualityWeight = 1.5;
+  // While the camera moves (camera.orbit, camera.set) and for kSettleSeconds after, surface frames march
+  // at most kMovingScale of the width and height (a quarter of the pixels), so a drag answers at the frame
+  // rate; then one frame at the chosen scale follows, paused or not.
+  static constexpr double kMovingScale = 0.5, kSettleSeconds = 0.3;
   // The next frame starts without waiting for the fps cap: someone waits to see a command's effect.
   void hurry();
   // Whether anyone receives frames; unwatched, the worker draws only its first frame (for picking).
@@ -103,7 +113,7 @@ class RenderWorker {
  private:
   void run();
   bool render_one(const std::shared_ptr<const RenderSnapshot>& snapshot, const RenderOptions& options,
-                  int jpeg_quality);
+                  int jpeg_quality, bool moving = false);
   void set_status(std::string s);
 
   Session& session_;
@@ -114,10 +124,13 @@ class RenderWorker {
   std::condition_variable cv_;
   RenderOptions options_;
   int jpeg_quality_ = 80;
-  // 12 frames a second: above the 10 a moving picture needs, and on 2 cores it leaves the simulation
-  // most of the time between frames (a client can ask for up to 60 with quality.set).
-  double fps_ = 12.0;
+  // 15 frames a second: above the 12 a moving picture needs with room for a slow frame, and on 2 cores
+  // the fast 640x480 frame (about 50 ms beside the simulation) leaves it a quarter of the time between
+  // frames (a client can ask for up to 60 with quality.set).
+  double fps_ = 15.0;
   bool hurry_ = false;
+  std::chrono::steady_clock::time_point moved_at_{};  // the camera's last move
+  bool settle_due_ = false;                           // a frame was drawn at kMovingScale
   bool watched_ = true;
   std::uint64_t options_version_ = 1;
   bool snapshot_pending_ = true;  // the session published since the last frame began

@@ -100,7 +100,8 @@ Json Service::quality_json() const {
           {"jpeg_quality", renderer_.jpeg_quality()},
           {"fps", renderer_.fps_cap()},
           {"fps_limit", renderer_.fps_limit()},
-          {"surface", now.quality}};
+          {"surface", now.quality},
+          {"scale", now.scale}};
 }
 
 Json Service::welcome(bool controller) const {
@@ -234,7 +235,7 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
           renderer_.set_view(c.view, c.colour_by);
           done({}, "", Json::object());
         } else if constexpr (std::is_same_v<T, QualitySet>) {
-          renderer_.set_quality(c.width, c.height, c.jpeg_quality, c.fps, c.surface);
+          renderer_.set_quality(c.width, c.height, c.jpeg_quality, c.fps, c.surface, c.scale);
           done({}, "", quality_json());
         } else if constexpr (std::is_same_v<T, DryerAim>) {
           const auto hit = renderer_.pick(c.x, c.y);
@@ -283,6 +284,9 @@ void Service::on_published() {
     s["frame"] = f->frame;
     s["render_ms"] = f->render_ms;
     s["encode_ms"] = f->encode_ms;
+    // What the frame on screen is: its march's scale, and whether it was drawn while the camera moved.
+    s["frame_scale"] = f->scale;
+    s["frame_moving"] = f->moving;
     s["fps"] = renderer_.fps();
   }
   const auto scene = session_.scene();
@@ -291,7 +295,7 @@ void Service::on_published() {
   s["lamps"] = lamps_json(*scene);
   const RenderOptions o = renderer_.options();
   s["view"] = view_json(o);
-  s["quality"] = {{"surface", o.quality}, {"width", o.width}, {"height", o.height}};
+  s["quality"] = {{"surface", o.quality}, {"width", o.width}, {"height", o.height}, {"scale", o.scale}};
   server_->broadcast_text(s.dump());
 }
 

@@ -3,7 +3,7 @@
 time from sending a dryer command to the arrival of the first frame drawn from the simulated time at
 which the command took effect (its ack says when) or later.
 
-    tools/stream_figures.py ws://127.0.0.1:8080/ [--fast] [--tries N]
+    tools/stream_figures.py ws://127.0.0.1:8080/ [--fast] [--scale S] [--fps F] [--tries N]
 """
 import argparse
 import asyncio
@@ -40,10 +40,11 @@ def summary(latencies_s):
     return "median %.0f ms, max %.0f ms (%s)" % (statistics.median(ms), ms[-1], " ".join("%.0f" % x for x in ms))
 
 
-async def main(url, fast, tries, fps):
+async def main(url, fast, tries, settings):
     async with thaw_client.connect(url) as thaw:
-        ack = await thaw.command("quality.set", surface="fast" if fast else "full", **fps)
-    print("surface quality %s, frame rate cap %g/s" % (ack["surface"], ack["fps"]))
+        ack = await thaw.command("quality.set", surface="fast" if fast else "full", **settings)
+    print("surface quality %s marched at %g of %dx%d, frame rate cap %g/s" %
+          (ack["surface"], ack["scale"], ack["width"], ack["height"], ack["fps"]))
     fps, steps = await viewer(url, 8)
     print("1 viewer: %.1f frames/s; simulation %.0f steps/s" % (fps, steps))
     print("1 viewer: dryer command to frame: " + summary(await latencies(url, tries)))
@@ -62,5 +63,7 @@ if __name__ == "__main__":
     parser.add_argument("--fast", action="store_true", help="ask for fast surface quality first")
     parser.add_argument("--tries", type=int, default=10, help="dryer commands timed per case")
     parser.add_argument("--fps", type=float, help="ask for this frame rate cap first")
+    parser.add_argument("--scale", type=float, help="ask for this fraction of width and height marched first")
     args = parser.parse_args()
-    asyncio.run(main(args.url, args.fast, args.tries, {"fps": args.fps} if args.fps else {}))
+    settings = {k: v for k, v in (("fps", args.fps), ("scale", args.scale)) if v}
+    asyncio.run(main(args.url, args.fast, args.tries, settings))

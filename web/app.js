@@ -124,6 +124,16 @@ function applyView(view, quality) {
     $('colour-by').value = view.colour_by;
   }
   if (quality && quality.surface) $('full-quality').checked = quality.surface === 'full';
+  if (quality && quality.scale !== undefined) showChoice('scale', quality.scale, (v) => `${Math.round(100 * Number(v))} %`);
+}
+
+// What the frame on screen is in the surface view: its quality and the size its march drew, stretched to
+// the image (the server draws frames at half the width and height while the camera moves).
+function frameQuality(m) {
+  if (!m.view || m.view.view !== 'surface' || !m.quality || m.frame_scale === undefined) return '';
+  const w = Math.round(m.quality.width * m.frame_scale), h = Math.round(m.quality.height * m.frame_scale);
+  const size = m.frame_scale < 1 ? `${w}×${h} stretched` : `${w}×${h}`;
+  return `   ${m.frame_moving ? 'moving' : m.quality.surface} ${size}`;
 }
 
 // A menu shows the server's value, adding it as an option when another client chose one not listed;
@@ -208,7 +218,7 @@ function onStats(m) {
   const lines = [
     `t ${m.time.toFixed(3)} s   ` +
       (rate === null ? '' : `${rate < 0.1 ? rate.toPrecision(2) : rate.toFixed(2)} s simulated per s   `) +
-      `heat ×${m.heat_time_scale}   ${fps.toFixed(1)} fps`,
+      `heat ×${m.heat_time_scale}   ${fps.toFixed(1)} fps` + frameQuality(m),
   ];
   if (m.ice_fraction !== null && m.ice_fraction !== undefined)
     lines.push(`ice ${(1000 * m.ice_mass).toFixed(2)} g (${(100 * m.ice_fraction).toFixed(1)} % of the start)`);
@@ -446,5 +456,6 @@ const sendView = () => send('view.set', { view: $('view-kind').value, colour_by:
 $('view-kind').addEventListener('change', sendView);
 $('colour-by').addEventListener('change', sendView);
 $('full-quality').addEventListener('change', (e) => send('quality.set', { surface: e.target.checked ? 'full' : 'fast' }));
+$('scale').addEventListener('change', (e) => send('quality.set', { scale: Number(e.target.value) }));
 
 connect();

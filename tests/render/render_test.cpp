@@ -385,6 +385,35 @@ TEST_F(RenderTest, FastQualityDiffersOnlyBehindIceAndWater) {
   EXPECT_GT(psnr(full_scene, fast_scene), 20.0) << "and nothing else changes much";
 }
 
+// A reduced march stretched to the image: the frame keeps the camera's size and shows the same picture,
+// softer (its silhouette within a few percent of the full march's, the PSNR high), but not the same
+// pixels; scale 1 is the full march exactly, and a scale outside kMinScale..1 is refused.
+TEST_F(RenderTest, AReducedMarchIsStretchedToTheImageAndShowsTheSamePicture) {
+  const DensityFields scene = scene_fields(64);
+  const OrbitCamera camera = scene_camera(320, 240);
+  const Image bg = background(camera);
+  const Image full = renderer().render(scene, camera);
+  renderer().set_scale(0.5);
+  const Image half = renderer().render(scene, camera);
+  const Image half_bg = background(camera);
+  renderer().set_scale(1.0);
+  const Image again = renderer().render(scene, camera);
+  ASSERT_EQ(half.width, 320);
+  ASSERT_EQ(half.height, 240);
+  EXPECT_EQ(again.rgba, full.rgba);
+  const long full_area = silhouette(full, bg), half_area = silhouette(half, half_bg);
+  const double quality = psnr(full, half);
+  std::printf("[ info ] silhouette %ld px marched in full, %ld at half scale; PSNR %.1f dB; %ld pixels differ\n",
+              full_area, half_area, quality, changed_pixels(full, half, 2));
+  EXPECT_GT(full_area, 5000);
+  EXPECT_NEAR(double(half_area), double(full_area), 0.04 * double(full_area));
+  EXPECT_GT(quality, 24.0);
+  EXPECT_GT(changed_pixels(full, half, 2), 100) << "the half-scale march must not be the full one";
+  EXPECT_THROW(renderer().set_scale(0.2), Error);
+  EXPECT_THROW(renderer().set_scale(1.5), Error);
+  EXPECT_EQ(renderer().scale(), 1.0);
+}
+
 // A cup: an open-topped box shell of `wall` thickness into `phase`, its inside [lo, hi] without the top.
 void add_cup(DensityFields& f, std::vector<float>& phase, const Vector3f& lo, const Vector3f& hi,
              float wall) {

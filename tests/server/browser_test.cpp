@@ -196,6 +196,11 @@ async def scenario(call, js, until):
     std::printf("%s\n", out.substr(at, out.find('\n', at) - at).c_str());
   std::printf("[ info ] screenshots: %s, %s\n", (dir.path() / "melt-start.png").c_str(),
               (dir.path() / "melt-10.png").c_str());
+  // THAW_TEST_SCREENSHOTS=DIR keeps them (docs/images/browser-melt-*.png come from here).
+  if (const char* keep = std::getenv("THAW_TEST_SCREENSHOTS"))
+    for (const char* name : {"melt-start.png", "melt-10.png"})
+      std::filesystem::copy_file(dir.path() / name, std::filesystem::path(keep) / ("browser-" + std::string(name)),
+                                 std::filesystem::copy_options::overwrite_existing);
   EXPECT_TRUE(served.stop()) << served.log();
 }
 
@@ -245,17 +250,36 @@ async def scenario(call, js, until):
     await call("Page.captureScreenshot", format="png")
     await js("{ const v = document.getElementById('view-kind'); v.value = 'surface'; v.dispatchEvent(new Event('change')); }")
     print("bar hidden", bool(await until("document.getElementById('bar-labels').hidden", 20)))
+    HUD = "document.getElementById('hud').textContent"
+    print("quality shown", bool(await until(f"{HUD}.includes('fast 480×360 stretched')", 20)))
+    # A drag on the canvas: frames march at half scale while it lasts, and the page says so.
+    box = await js("(() => { const r = document.getElementById('view').getBoundingClientRect(); return [r.x + r.width / 2, r.y + r.height / 2]; })()")
+    x, y = box
+    await call("Input.dispatchMouseEvent", type="mousePressed", x=x, y=y, button="left", clickCount=1)
+    seen = False
+    for i in range(40):
+        x += 3
+        await call("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y, button="left", buttons=1)
+        await asyncio.sleep(0.1)
+        seen = seen or "moving 320×240 stretched" in await js(HUD)
+    await call("Input.dispatchMouseEvent", type="mouseReleased", x=x, y=y, button="left", clickCount=1)
+    print("moving shown", seen)
+    print("settled", bool(await until(f"{HUD}.includes('fast 480×360 stretched')", 20)))
+    await js("{ const s = document.getElementById('scale'); s.value = '0.5'; s.dispatchEvent(new Event('change')); }")
+    async with thaw_client.connect(URL) as other:
+        print("detail set", other.welcome["quality"]["scale"] if await until(f"{HUD}.includes('fast 320×240 stretched')", 20) else None)
     await js("document.getElementById('full-quality').click()")
     await asyncio.sleep(0.5)
     await call("Page.reload")
     await asyncio.sleep(1)
-    print("reloaded", bool(await until("welcome && document.getElementById('full-quality').checked", 30)))
+    print("reloaded", bool(await until("welcome && document.getElementById('full-quality').checked && document.getElementById('scale').value === '0.5'", 30)))
 )py"),
                                             240, &status);
   EXPECT_EQ(status, 0) << out;
   expect_lines(out, {"connected True", "welcome True", "sliders 70 0 1000", "dryer set True", "orbited 70.0",
                      "reset view 30.0", "scene changed True", "panels true false 1", "lamp toggled True",
-                     "back True", "fresh sliders 70 False", "bar labelled True", "bar hidden True", "reloaded True", "screenshot True"});
+                     "back True", "fresh sliders 70 False", "bar labelled True", "bar hidden True", "quality shown True",
+                     "moving shown True", "settled True", "detail set 0.5", "reloaded True", "screenshot True"});
   std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
   EXPECT_TRUE(served.stop()) << served.log();
 }

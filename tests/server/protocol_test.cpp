@@ -279,7 +279,8 @@ TEST(ProtocolParse, ViewAndQuality) {
   EXPECT_EQ(q.fps, 15.0);
   EXPECT_EQ(q.surface, "fast");
   const QualitySet fps_only = parsed<QualitySet>(R"({"type":"quality.set","fps":60})");
-  EXPECT_FALSE(fps_only.width || fps_only.height || fps_only.jpeg_quality || fps_only.surface);
+  EXPECT_FALSE(fps_only.width || fps_only.height || fps_only.jpeg_quality || fps_only.surface || fps_only.scale);
+  EXPECT_EQ(parsed<QualitySet>(R"({"type":"quality.set","scale":0.5})").scale, 0.5);
 }
 
 TEST(ProtocolParse, FrameAck) {
@@ -577,6 +578,9 @@ TEST(ProtocolRefuse, ViewAndQuality) {
       {R"({"type":"quality.set","fps":0.5})", "quality.set", "fps"},
       {R"({"type":"quality.set","fps":61})", "quality.set", "fps"},
       {R"({"type":"quality.set","surface":"best"})", "quality.set", "surface"},
+      {R"({"type":"quality.set","scale":0.2})", "quality.set", "scale"},
+      {R"({"type":"quality.set","scale":1.5})", "quality.set", "scale"},
+      {R"({"type":"quality.set","scale":"half"})", "quality.set", "scale"},
   });
 }
 

@@ -486,8 +486,13 @@ TEST_F(RenderWorkerTest, TheCameraStaysOnTheSceneAndFramesKeepWithinThePixelBudg
   EXPECT_LE(far.target.x(), double(snapshot->domain_max.x()) + diagonal + 1e-9);
   EXPECT_GE(far.target.y(), double(snapshot->domain_min.y()) - diagonal - 1e-9);
 
-  // The default frame is within the budget; the largest one is held to a frame rate the budget allows.
+  // The service's frame (640x480, fast, 3/4 scale) is within the budget at the default cap; every pixel
+  // at full quality is held to 13 frames a second; the largest frame to a rate the budget allows.
+  w.set_quality(std::nullopt, std::nullopt, std::nullopt, std::nullopt, "fast", 0.75);
   EXPECT_EQ(w.fps_limit(), w.fps_cap());
+  w.set_quality(std::nullopt, std::nullopt, std::nullopt, std::nullopt, "full", 1.0);
+  EXPECT_NEAR(w.fps_limit(), RenderWorker::kMaxPixelsPerSecond / (640.0 * 480 * RenderWorker::kFullQualityWeight),
+              1e-9);
   w.set_quality(1920, 1080, 95, 60.0, "full");
   EXPECT_EQ(w.fps_cap(), 60.0);
   EXPECT_NEAR(w.fps_limit(),
@@ -607,6 +612,52 @@ TEST_F(RenderWorkerTest, UnwatchedDrawsOnlyItsFirstFrameAndHurrySkipsTheFpsCap) 
   EXPECT_GT(w.fps(), 0.0);
   w.stop();
   s.stop();
+}
+
+// While the camera moves, surface frames march at kMovingScale and say so; once it stops for
+// kSettleSeconds, one frame at the chosen scale follows though the simulation is paused (no new
+// snapshot asks for it), and then none.
+TEST_F(RenderWorkerTest, FramesMarchAtHalfScaleWhileTheCameraMovesAndOneAtTheChosenScaleFollows) {
+  Session s(cl(), "ice-on-plate", {"spacing=0.006"}, (dir_.path() / "states").string());  // not started
+  RenderWorker w(s);
+  EXPECT_THROW(w.set_quality(std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt, 0.2), Error);
+  w.set_quality(160, 120, 70, 60.0, "fast", 0.75);
+  EXPECT_EQ(w.options().scale, 0.75);
+  w.start();
+  auto first = w.wait_for_frame(0, 30s);
+  if (!first && w.status().rfind("error", 0) == 0) GTEST_SKIP() << "no EGL here: " << w.status();
+  ASSERT_TRUE(first) << w.status();
+  EXPECT_EQ(first->scale, 0.75);
+  EXPECT_FALSE(first->moving);
+  EXPECT_EQ(first->width, 160);
+
+  w.orbit(15, 0, 1);
+  auto moving = w.wait_for_frame(first->frame, 30s);
+  ASSERT_TRUE(moving && moving->frame > first->frame);
+  EXPECT_TRUE(moving->moving);
+  EXPECT_EQ(moving->scale, RenderWorker::kMovingScale);
+  EXPECT_EQ(moving->width, 160) << "the frame keeps its size; only the march is smaller";
+  EXPECT_EQ(jpeg_size(moving->jpeg), std::make_pair(160, 120));
+
+  const auto stopped = std::chrono::steady_clock::now();
+  auto settled = w.wait_for_frame(moving->frame, 30s);
+  ASSERT_TRUE(settled && settled->frame > moving->frame);
+  const double after = std::chrono::duration<double>(std::chrono::steady_clock::now() - stopped).count();
+  EXPECT_FALSE(settled->moving);
+  EXPECT_EQ(settled->scale, 0.75);
+  EXPECT_GE(after, 0.5 * RenderWorker::kSettleSeconds);
+  EXPECT_EQ(w.wait_for_frame(settled->frame, 600ms)->frame, settled->frame) << "nothing changed: no frame";
+
+  // A chosen scale at or below kMovingScale is kept while moving.
+  w.set_quality(std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt, 0.25);
+  auto small = w.wait_for_frame(settled->frame, 30s);
+  ASSERT_TRUE(small);
+  w.orbit(15, 0, 1);
+  auto small_moving = w.wait_for_frame(small->frame, 30s);
+  ASSERT_TRUE(small_moving && small_moving->frame > small->frame);
+  EXPECT_EQ(small_moving->scale, 0.25);
+  EXPECT_FALSE(small_moving->moving);
+  w.stop();
 }
 
 TEST(ThreadPriority, LoweredForThisThreadAndInheritedByItsThreads) {
