@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <vector>
 
 #include "sim/particles.h"
 
@@ -45,6 +48,101 @@ ColourBar draw_colour_bar(Image& image) {
       px[3] = 255;
     }
   return bar;
+}
+
+namespace {
+
+// 5x7 glyphs, a row per byte, the leftmost pixel in bit 4.
+struct Glyph {
+  const char* utf8;
+  std::uint8_t rows[7];
+};
+constexpr Glyph kGlyphs[] = {
+    {"0", {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}}, {"1", {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+    {"2", {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}}, {"3", {0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E}},
+    {"4", {0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02}}, {"5", {0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E}},
+    {"6", {0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E}}, {"7", {0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08}},
+    {"8", {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}}, {"9", {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C}},
+    {".", {0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C}}, {"-", {0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00}},
+    {"+", {0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00}}, {"\u00B0", {0x0C, 0x12, 0x12, 0x0C, 0x00, 0x00, 0x00}},
+    {"C", {0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E}},
+};
+constexpr int kGlyphW = 5, kGlyphH = 7;
+
+// The glyphs of `text` in order (nullptr: a blank cell); '°' is two bytes in UTF-8.
+std::vector<const Glyph*> glyphs_of(const std::string& text) {
+  std::vector<const Glyph*> out;
+  for (std::size_t i = 0; i < text.size();) {
+    const Glyph* found = nullptr;
+    std::size_t used = 1;
+    for (const Glyph& g : kGlyphs) {
+      const std::size_t n = std::strlen(g.utf8);
+      if (text.compare(i, n, g.utf8) == 0) {
+        found = &g;
+        used = n;
+        break;
+      }
+    }
+    out.push_back(found);
+    i += used;
+  }
+  return out;
+}
+
+void fill(Image& image, int x0, int y0, int x1, int y1, const Rgb& c) {
+  for (int y = std::max(0, y0); y < std::min(image.height, y1); ++y)
+    for (int x = std::max(0, x0); x < std::min(image.width, x1); ++x) {
+      std::uint8_t* px = &image.rgba[(std::size_t(y) * image.width + x) * 4];
+      px[0] = c[0];
+      px[1] = c[1];
+      px[2] = c[2];
+      px[3] = 255;
+    }
+}
+
+}  // namespace
+
+int text_width(const std::string& text, int scale) {
+  const int n = static_cast<int>(glyphs_of(text).size());
+  return n == 0 ? 0 : scale * (n * (kGlyphW + 1) - 1);
+}
+
+void draw_text(Image& image, const std::string& text, int x, int y, int scale, const Rgb& colour) {
+  int left = x;
+  for (const Glyph* g : glyphs_of(text)) {
+    if (g)
+      for (int r = 0; r < kGlyphH; ++r)
+        for (int c = 0; c < kGlyphW; ++c)
+          if (g->rows[r] & (0x10 >> c))
+            fill(image, left + c * scale, y + r * scale, left + (c + 1) * scale, y + (r + 1) * scale, colour);
+    left += (kGlyphW + 1) * scale;
+  }
+}
+
+std::array<std::string, 3> colour_bar_labels(double lo, double hi) {
+  std::array<std::string, 3> out;
+  const double values[3] = {hi, 0.5 * (lo + hi), lo};
+  for (int k = 0; k < 3; ++k) {
+    char text[48];
+    // "-0.0" reads as a different temperature from "0.0"; it is the same one.
+    const double v = std::abs(values[k]) < 0.05 ? 0.0 : values[k];
+    std::snprintf(text, sizeof text, "%.1f \u00B0C", v);
+    out[std::size_t(k)] = text;
+  }
+  return out;
+}
+
+void label_colour_bar(Image& image, const ColourBar& bar, double lo, double hi) {
+  const int scale = std::max(1, image.height / 240), pad = scale;
+  const auto labels = colour_bar_labels(lo, hi);
+  const int ys[3] = {bar.y0, (bar.y0 + bar.y1) / 2, bar.y1 - 1};
+  for (int k = 0; k < 3; ++k) {
+    const std::string& text = labels[std::size_t(k)];
+    const int w = text_width(text, scale), h = kGlyphH * scale;
+    const int right = bar.x0 - 1 - 2 * scale, x = right - w, y = ys[k] - h / 2;
+    fill(image, x - pad, y - pad, right + pad, y + h + pad, Rgb{30, 30, 30});
+    draw_text(image, text, x, y, scale, Rgb{235, 235, 235});
+  }
 }
 
 }  // namespace thaw

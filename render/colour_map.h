@@ -2,6 +2,7 @@
 // Colours of the particle and slice views: one per phase, and a temperature scale with its colour bar.
 #include <array>
 #include <cstdint>
+#include <string>
 
 #include "render/image.h"
 
@@ -21,5 +22,16 @@ struct ColourBar {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the strip's pixel box, inclusive-exclusive
 };
 ColourBar draw_colour_bar(Image& image);
+
+// The bar's numbers: `hi` at its top, the middle, `lo` at its bottom, as "12.3 °C", drawn left of the
+// strip in a 5x7 pixel font (scaled with the image: 2x at 480 rows) on a dark plate, so every picture
+// of a temperature view, a PNG from `thaw render` or a streamed frame, says what its colours mean.
+void label_colour_bar(Image& image, const ColourBar& bar, double lo, double hi);
+std::array<std::string, 3> colour_bar_labels(double lo, double hi);  // top, middle, bottom
+
+// Text in the 5x7 font: digits, '.', '-', '+', ' ', '°' and 'C' (anything else is a blank cell),
+// `scale` image pixels per font pixel, its top left at (x, y); clipped to the image.
+void draw_text(Image& image, const std::string& text, int x, int y, int scale, const Rgb& colour);
+int text_width(const std::string& text, int scale);  // pixels, one blank column between characters
 
 }  // namespace thaw

@@ -98,7 +98,10 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, cons
           p[k] = static_cast<std::uint8_t>(std::lround(colour[std::size_t(k)] * shade));
       }
   }
-  if (by_t) out.bar = draw_colour_bar(out.image);
+  if (by_t) {
+    out.bar = draw_colour_bar(out.image);
+    label_colour_bar(out.image, out.bar, out.t_min, out.t_max);
+  }
   return out;
 }
 
@@ -157,6 +160,7 @@ ViewImage render_slice(const RenderSnapshot& s, const SliceOptions& o) {
       px[2] = c[2];
     }
   out.bar = draw_colour_bar(out.image);
+  label_colour_bar(out.image, out.bar, out.t_min, out.t_max);
   return out;
 }
 

@@ -230,32 +230,7 @@ function onStats(m) {
       (m.energy ? `energy closure ${m.energy.closure_relative.toExponential(1)}` : ''));
   if (m.error) lines.push(`stopped: ${m.error}`);
   hud.textContent = lines.join('\n');
-  labelColourBar(T);
   drawPlot();
-}
-
-// The frame's colour bar (render/colour_map.cpp: the strip's top at 1/8 of the height, its bottom at
-// 7/8, against the right edge) runs from the coldest to the warmest ice or water, which the stats' min
-// and max temperature give: label its ends and middle in °C beside it.
-function labelColourBar(T) {
-  const shown = T && ($('view-kind').value === 'slice' ||
-                      ($('view-kind').value === 'particles' && $('colour-by').value === 'temperature'));
-  $('bar-labels').hidden = !shown;
-  if (!shown) return;
-  let lo = T.min, hi = T.max;
-  if (hi - lo < 1e-3) [lo, hi] = [lo - 0.5, hi + 0.5];  // as the renderer widens a flat range
-  const scale = canvas.clientHeight / canvas.height;
-  const margin = Math.max(4, canvas.width / 80), width = Math.max(6, canvas.width / 40);
-  const barLeft = canvas.offsetLeft + (canvas.width - margin - width) * scale;  // in #stage's pixels
-  const place = (id, fraction, value) => {
-    const el = $(id);
-    el.textContent = `${value.toFixed(1)} °C`;
-    el.style.top = `${canvas.offsetTop + (canvas.height / 8 + (fraction * canvas.height * 3) / 4) * scale}px`;
-    el.style.right = `${canvas.parentElement.clientWidth - barLeft + 3}px`;
-  };
-  place('bar-top', 0, hi);
-  place('bar-mid', 0.5, (lo + hi) / 2);
-  place('bar-bottom', 1, lo);
 }
 
 function fillSelect(select, values, current) {

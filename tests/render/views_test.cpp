@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "render/colour_map.h"
 #include "render/particle_view.h"
 #include "sim/error.h"
 #include "sim/particles.h"
@@ -116,10 +117,61 @@ TEST(SliceView, LinearTemperatureRunsAcrossTheColourBar) {
   auto column_of = [&](double x) {
     return static_cast<int>(std::lround(0.5 * o.width + x / (0.2 * 1.05 / o.width)));
   };
-  const int y = o.height / 2;
+  const int y = o.height / 2 + 20;  // below the bar's middle label
   EXPECT_GT(chroma(v.image.pixel(column_of(-0.09), y)).dot(chroma(cool_warm(0.05))), 0.995);
   EXPECT_GT(chroma(v.image.pixel(column_of(0.0), y)).dot(chroma(cool_warm(0.5))), 0.995);
   EXPECT_GT(chroma(v.image.pixel(column_of(0.09), y)).dot(chroma(cool_warm(0.95))), 0.995);
+}
+
+// Light pixels (the labels' text) in a box of the image.
+int light_pixels(const Image& image, int x0, int y0, int x1, int y1) {
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) n += image.pixel(x, y)[0] > 200 && image.pixel(x, y)[2] > 200;
+  return n;
+}
+
+// The colour bar says what its colours mean: its top, middle and bottom in °C, left of the strip, in
+// every temperature view (a PNG of `thaw render` as much as a streamed frame).
+TEST(ColourBar, LabelsSayTheRangeInDegreesBesideTheStrip) {
+  EXPECT_EQ(colour_bar_labels(-5, 35), (std::array<std::string, 3>{"35.0 °C", "15.0 °C", "-5.0 °C"}));
+  EXPECT_EQ(colour_bar_labels(-0.04, 0.04)[1], "0.0 °C");
+  EXPECT_EQ(text_width("8", 2), 10);
+  EXPECT_EQ(text_width("12", 1), 11);
+  EXPECT_EQ(text_width("", 3), 0);
+
+  Image a(640, 480), b(640, 480);
+  for (Image* im : {&a, &b})
+    for (std::size_t i = 0; i < im->rgba.size(); ++i) im->rgba[i] = 90;
+  const ColourBar bar = draw_colour_bar(a);
+  draw_colour_bar(b);
+  const Image bare = a;
+  label_colour_bar(a, bar, 0, 10);
+  label_colour_bar(b, bar, 0, 20);
+  // Text at the top, middle and bottom, within 60 px left of the strip; nothing right of it or far left.
+  for (const int y : {bar.y0, (bar.y0 + bar.y1) / 2, bar.y1 - 1})
+    EXPECT_GT(light_pixels(a, bar.x0 - 120, y - 8, bar.x0, y + 8), 60) << "row " << y;
+  EXPECT_EQ(light_pixels(a, bar.x1 + 1, 0, a.width, a.height), 0);
+  EXPECT_EQ(light_pixels(a, 0, 0, bar.x0 - 130, a.height), 0);
+  EXPECT_EQ(light_pixels(bare, 0, 0, bar.x0 - 1, a.height), 0);  // the strip itself has near-white
+  // Another range, other numbers: the top and middle labels change, the bottom one (0.0) does not.
+  auto differs = [&](int y) {
+    for (int yy = y - 8; yy < y + 8; ++yy)
+      for (int x = bar.x0 - 120; x < bar.x0; ++x)
+        if (a.pixel(x, yy)[0] != b.pixel(x, yy)[0]) return true;
+    return false;
+  };
+  EXPECT_TRUE(differs(bar.y0));
+  EXPECT_TRUE(differs((bar.y0 + bar.y1) / 2));
+  EXPECT_FALSE(differs(bar.y1 - 1));
+
+  // The slice view draws them.
+  RenderSnapshot s = two_particles(-2.0f, 8.0f);
+  SliceOptions o;
+  o.width = 320;
+  o.height = 240;
+  const ViewImage v = render_slice(s, o);
+  EXPECT_GT(light_pixels(v.image, v.bar.x0 - 60, v.bar.y0 - 5, v.bar.x0, v.bar.y0 + 5), 20);
 }
 
 }  // namespace

@@ -100,8 +100,8 @@ asyncio.run(main())
                                             120, &status);
   EXPECT_EQ(status, 0) << out;
   for (const char* line : {"welcome default 1 40.0 surface fast 1000.0 False",
-                           "scene event ice-on-plate 0 0 30.0 50.0 0.0 None", "quality kept full description True",
-                           "reload ice-on-plate full", "reset 30.0 50.0"})
+                           "scene event ice-on-plate 0 0 -60.0 35.0 0.0 None", "quality kept full description True",
+                           "reload ice-on-plate full", "reset -60.0 35.0"})
     EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
   EXPECT_TRUE(served.stop()) << served.log();
 }
