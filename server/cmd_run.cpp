@@ -229,6 +229,14 @@ int cmd_run(int argc, char** argv) {
           m.ice_mass, m.water_mass, m.min_temperature, m.max_temperature, m.mean_temperature, b.heat_in(),
           b.ambient, b.lamps, b.dryers, b.walls, b.held, -b.outflow, b.inflow, m.closure());
     }
+    if (!m.pressure_solve.is_null()) {
+      const Json& d = m.pressure_solve;
+      std::printf("dfsph: %.2f density and %.2f divergence iterations per step (mean); last step's errors %.3g "
+                  "(tolerance %.3g) and %.3g (tolerance %.3g)\n",
+                  d["mean_density_iterations"].get<double>(), d["mean_divergence_iterations"].get<double>(),
+                  d["density"]["error"].get<double>(), d["density"]["tolerance"].get<double>(),
+                  d["divergence"]["error"].get<double>(), d["divergence"]["tolerance"].get<double>());
+    }
     if (!m.bodies.is_null()) {
       int free = 0, fixed = 0;
       for (const auto& b : m.bodies["list"]) (b["fixed"].get<bool>() ? fixed : free)++;
@@ -236,6 +244,18 @@ int cmd_run(int argc, char** argv) {
                   (unsigned long long)m.bodies["labellings"].get<std::uint64_t>(),
                   m.bodies["last_sweeps"].get<int>());
     }
+  }
+  if (const DfsphStage* d = solver.dfsph()) {
+    const PressureSolveTotals& t = d->totals();
+    if (t.density_unconverged || t.divergence_unconverged)
+      std::fprintf(stderr,
+                   "thaw run: warning: the DFSPH density solve stopped at solver.max_pressure_iterations = %d "
+                   "before its tolerance in %llu of %llu steps (worst mean density error %.3g against %.3g), "
+                   "the divergence solve in %llu; raise max_pressure_iterations or the tolerances, or lower "
+                   "solver.max_dt\n",
+                   solver.scene().solver.max_pressure_iterations, (unsigned long long)t.density_unconverged,
+                   (unsigned long long)t.steps, t.worst_density_error, solver.scene().solver.density_tolerance,
+                   (unsigned long long)t.divergence_unconverged);
   }
   return g_stop ? 130 : 0;
 }

@@ -52,6 +52,7 @@ class FluidStage {
   // Per particle: (rho, p / rho^2, is_boundary, p) from the density pass; accelerations from forces.
   const cl::Buffer& state() const { return state_; }
   const cl::Buffer& accel() const { return accel_; }
+  const cl::Buffer& flow() const { return flow_; }  // the material table (fluid_params.h)
 
  private:
   ClRuntime& cl_;

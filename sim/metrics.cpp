@@ -72,7 +72,26 @@ Metrics measure(const Solver& s) {
   m.outflow = s.outflow();
   m.inflow = s.inflow();
   m.bodies = bodies_json(s);
+  m.pressure_solve = pressure_solve_json(s);
   return m;
+}
+
+Json pressure_solve_json(const Solver& s) {
+  const DfsphStage* d = s.dfsph();
+  if (!d) return nullptr;
+  const PressureSolveTotals& t = d->totals();
+  const double steps = double(std::max<std::uint64_t>(t.steps, 1));
+  auto solve = [](const PressureSolve& p, double tolerance) {
+    return Json{{"iterations", p.iterations}, {"error", p.error}, {"tolerance", tolerance}, {"converged", p.converged}};
+  };
+  const SolverSettings& st = s.scene().solver;
+  return {{"density", solve(d->last_density(), st.density_tolerance)},
+          {"divergence", solve(d->last_divergence(), st.divergence_tolerance)},
+          {"mean_density_iterations", double(t.density_iterations) / steps},
+          {"mean_divergence_iterations", double(t.divergence_iterations) / steps},
+          {"unconverged_density_steps", t.density_unconverged},
+          {"unconverged_divergence_steps", t.divergence_unconverged},
+          {"worst_unconverged_density_error", t.worst_density_error}};
 }
 
 Json bodies_json(const Solver& s) {
@@ -109,6 +128,7 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
   j["total_mass"] = m.heat ? m.water_mass + m.ice_mass : m.fluid_mass;
   j["energy"] = {{"kinetic", m.kinetic}, {"potential", m.potential}, {"mechanical", m.kinetic + m.potential}};
   if (!m.bodies.is_null()) j["bodies"] = m.bodies;
+  if (!m.pressure_solve.is_null()) j["dfsph"] = m.pressure_solve;
   if (m.outflow.particles)
     j["outflow"] = {{"particles", m.outflow.particles},
                     {"mass", m.outflow.mass},

@@ -30,7 +30,12 @@ struct Metrics {
   // Rigid ice (scenes with free ice): one object per body (label, particles, mass, fixed, centre,
   // velocity, angular velocity) and the labelling counters; null otherwise.
   Json bodies;
+  // DFSPH (solver.pressure dfsph): the last step's solves and the run's counts; null otherwise.
+  Json pressure_solve;
 };
+
+// What a DFSPH solver reports of its solves (null for WCSPH).
+Json pressure_solve_json(const Solver& solver);
 
 // The bodies of a solver's rigid ice as Metrics::bodies writes them (null without rigid ice).
 Json bodies_json(const Solver& solver);

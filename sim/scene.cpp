@@ -39,6 +39,7 @@ const char* name(KernelFunction k) {
   return k == KernelFunction::WendlandC2 ? "wendland_c2" : "cubic_spline";
 }
 const char* name(Eos e) { return e == Eos::Tait ? "tait" : "linear"; }
+const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph" : "wcsph"; }
 const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
 const char* name(ExposedArea) { return "iwasaki2010"; }
 
@@ -705,6 +706,10 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.kernel =
       choice_of<KernelFunction>(j["kernel"], {KernelFunction::CubicSpline, KernelFunction::WendlandC2});
   s.support_ratio = j["support_ratio"].get<double>();
+  s.pressure = choice_of<PressureSolver>(j["pressure"], {PressureSolver::Wcsph, PressureSolver::Dfsph});
+  s.density_tolerance = j["density_tolerance"].get<double>();
+  s.divergence_tolerance = j["divergence_tolerance"].get<double>();
+  s.max_pressure_iterations = j["max_pressure_iterations"].get<int>();
   s.eos = choice_of<Eos>(j["eos"], {Eos::Tait, Eos::Linear});
   s.gamma = j["gamma"].get<double>();
   s.speed_of_sound = j["speed_of_sound"].get<double>();

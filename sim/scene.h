@@ -28,11 +28,15 @@ struct Box {
 enum class MaterialKind { Fluid, Solid, Ice };
 enum class KernelFunction { CubicSpline, WendlandC2 };
 enum class Eos { Tait, Linear };
+// The pressure solver: weakly compressible (an equation of state), or divergence-free SPH (Bender &
+// Koschier 2015, 2017: sim/dfsph_stage.h).
+enum class PressureSolver { Wcsph, Dfsph };
 enum class BoundaryVolume { Lattice, Akinci2012 };
 enum class ExposedArea { Iwasaki2010 };
 const char* name(MaterialKind k);    // "fluid", "solid", "ice"
 const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
 const char* name(Eos e);             // "tait", "linear"
+const char* name(PressureSolver p);  // "wcsph", "dfsph"
 const char* name(BoundaryVolume b);  // "lattice", "akinci"
 const char* name(ExposedArea a);     // "iwasaki2010" (also the heat pass's function suffix)
 
@@ -132,6 +136,10 @@ struct HeatSettings {
 struct SolverSettings {
   KernelFunction kernel = KernelFunction::CubicSpline;
   double support_ratio = 2.0;  // kernel support radius / particle spacing
+  PressureSolver pressure = PressureSolver::Wcsph;
+  double density_tolerance = 0.001;     // dfsph: mean (rho - rho0) / rho0 the density solve stops at
+  double divergence_tolerance = 0.001;  // dfsph: mean (D rho / Dt) dt / rho0 the divergence solve stops at
+  int max_pressure_iterations = 100;    // dfsph: per solve and step
   Eos eos = Eos::Tait;
   double gamma = 7.0;                  // Tait exponent
   double speed_of_sound = 0.0;         // [m/s]; 0 = sound_speed_factor * reference_speed

@@ -16,6 +16,26 @@ const Field& solver_schema() {
               .def(2.0)
               .at_least(1.2)
               .at_most(4),
+          choice("pressure", {"wcsph", "dfsph"},
+                 "Pressure solver: wcsph = weakly compressible, an equation of state (eos) and a sound-speed "
+                 "time step; dfsph = divergence-free SPH (Bender & Koschier 2015, 2017), constant density by "
+                 "iteration and a velocity time step")
+              .def("wcsph"),
+          number("density_tolerance",
+                 "dfsph: the density solve stops when the mean compression (rho - rho0) / rho0 is below this")
+              .def(0.001)
+              .above(0)
+              .at_most(0.1),
+          number("divergence_tolerance",
+                 "dfsph: the divergence solve stops when the mean compression rate (D rho / Dt) dt / rho0 is "
+                 "below this")
+              .def(0.001)
+              .above(0)
+              .at_most(0.1),
+          integer("max_pressure_iterations", "dfsph: the most iterations of each solve per step")
+              .def(100)
+              .at_least(2)
+              .at_most(10000),
           choice("eos", {"tait", "linear"}, "Equation of state: Tait (stiff) or linear in density")
               .def("tait"),
           number("gamma", "Tait exponent").def(7.0).at_least(1).at_most(10),

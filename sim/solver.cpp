@@ -122,7 +122,6 @@ SolverConstants derive_constants(const Scene& scene) {
     v_ref = std::max(v_ref, 0.1);  // a still fluid in zero gravity still needs a finite stiffness
   }
   k.sound_speed = static_cast<float>(s.speed_of_sound > 0 ? s.speed_of_sound : s.sound_speed_factor * v_ref);
-  const double c2 = double(k.sound_speed) * k.sound_speed;
   k.max_speed = static_cast<float>(s.max_speed > 0 ? s.max_speed : 5.0 * k.sound_speed);
   const float h = k.smoothing;
   const fluid::MaterialFlow first = flow_row(s, k.rest_density, k.kinematic_viscosity, k.sound_speed, h);
@@ -130,9 +129,15 @@ SolverConstants derive_constants(const Scene& scene) {
   k.visc_fluid = first.viscosity;
   k.visc_boundary = static_cast<float>(s.boundary_viscosity * k.sound_speed * h);
   const double dx = scene.spacing;
-  k.repulsion = static_cast<float>(c2 / (dx * dx * k.rest_density * dx * dx * dx));
+  // The walls' push is a spring of angular frequency c_push / dx: with WCSPH's acoustic step that is the
+  // sound speed. DFSPH's steps are as long as the flow allows, and symplectic Euler needs omega dt < 2:
+  // there the spring stiffens only enough to stop the fastest expected flow within a third of a spacing,
+  // c_push = 3 v_ref (omega dt = 0.66 at the default max_dt in a 25 cm column).
+  const double c_push =
+      s.pressure == PressureSolver::Dfsph ? std::min(double(k.sound_speed), 3.0 * v_ref) : double(k.sound_speed);
+  k.repulsion = static_cast<float>(c_push * c_push / (dx * dx * k.rest_density * dx * dx * dx));
   k.repulsion_range = static_cast<float>(0.95 * dx);
-  k.repulsion_damping = static_cast<float>(dx / k.sound_speed);
+  k.repulsion_damping = static_cast<float>(dx / c_push);
 
   const double inf = std::numeric_limits<double>::infinity();
   const double alpha = max_diffusivity(scene);
@@ -192,7 +197,10 @@ std::string program_options(const Scene& scene) {
   const bool wendland = scene.solver.kernel == KernelFunction::WendlandC2;
   opts << "-DKERNEL_W=" << (wendland ? "wendland_c2_w" : "cubic_spline_w")
        << " -DKERNEL_GRAD=" << (wendland ? "wendland_c2_grad_factor" : "cubic_spline_grad_factor");
-  if (scene.solver.eos == Eos::Tait) opts << " -DTHAW_EOS_TAIT";
+  const bool dfsph = scene.solver.pressure == PressureSolver::Dfsph;
+  // DFSPH solves for the pressure: the density pass writes none (sim/kernels/density.cl).
+  if (dfsph) opts << " -DTHAW_DFSPH";
+  if (scene.solver.eos == Eos::Tait && !dfsph) opts << " -DTHAW_EOS_TAIT";
   if (scene.solver.eos == Eos::Tait && scene.solver.gamma == 7.0) opts << " -DTHAW_GAMMA_7";
   if (wendland) opts << " -DTHAW_WENDLAND";
   // Flush subnormal floats: viscosity spreads velocities of 1e-30 m/s and less through a resting
@@ -282,6 +290,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   // The stages this scene needs, each declaring its fields; then the fields are allocated and filled.
   rigid_.reset();
   heat_.reset();
+  dfsph_.reset();
   fluid_.reset();
   grid_.reset();
   store_.clear();
@@ -289,6 +298,9 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   f_ = add_core_fields(store_);
   grid_ = std::make_unique<NeighbourGrid>(cl_, scene_, k_.support, kGridReach, opts, layout_, lo, hi);
   if (scene_.solver.flow) fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_);
+  if (fluid_ && scene_.solver.pressure == PressureSolver::Dfsph)
+    dfsph_ = std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_.support, scene_.spacing, opts, layout_,
+                                          fluid_->flow());
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
   if (plan.build)
     heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
@@ -505,7 +517,12 @@ double Solver::choose_time_step() {
   }
   const double h = k_.smoothing;
   double dt = s.max_dt;
-  dt = std::min(dt, s.cfl * h / (k_.sound_speed + vmax));  // CFL (acoustic + advective)
+  if (dfsph_) {
+    // Incompressible: the CFL condition on the flow's speed alone (Bender & Koschier 2017, sec. 4.1).
+    if (vmax > 0) dt = std::min(dt, s.cfl * h / vmax);
+  } else {
+    dt = std::min(dt, s.cfl * h / (k_.sound_speed + vmax));  // CFL (acoustic + advective)
+  }
   if (amax2 > 0) dt = std::min(dt, s.force_number * std::sqrt(h / std::sqrt(amax2)));
   if (k_.kinematic_viscosity > 0) dt = std::min(dt, s.viscous_number * h * h / k_.kinematic_viscosity);
   const double dt_heat = heat_time_step();
@@ -549,6 +566,10 @@ void Solver::integrate(double dt) {
 }
 
 void Solver::step() {
+  if (dfsph_) {
+    step_dfsph();
+    return;
+  }
   const bool flow = scene_.solver.flow;
   // Without flow nothing moves: one sort serves the whole run.
   if (flow || !grid_built_) timed(Stage::Grid, [&] { build_grid(); });
@@ -566,6 +587,40 @@ void Solver::step() {
   }
   if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
   if (flow) timed(Stage::Integrate, [&] { integrate(dt); });
+  time_ += dt;
+  dt_ = dt;
+  ++steps_;
+  if (emitters_) timed(Stage::Emit, [&] { emit(dt); });
+}
+
+// Bender & Koschier 2017, Algorithm 1, started at its neighbourhood update: the densities and alpha of
+// the particles where the last step left them, the divergence solve with that step's dt, the non-pressure
+// forces, the time step from the velocities, heat, v += dt a, the density solve, then ice and positions.
+void Solver::step_dfsph() {
+  timed(Stage::Grid, [&] { build_grid(); });
+  if (rigid_) timed(Stage::Bodies, [&] { rigid_->relabel_if_due(buffers(), steps_); });
+  timed(Stage::Density, [&] {
+    compute_density();
+    dfsph_->prepare(neighbours());
+  });
+  timed(Stage::Pressure, [&] { dfsph_->divergence_solve(neighbours(), dt_); });
+  timed(Stage::Forces, [&] { compute_forces(); });
+  double dt = 0;
+  timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
+  if (heat_) {
+    timed(Stage::Photons, [&] { trace_photons(dt); });
+    timed(Stage::Heat, [&] { compute_heat(dt); });
+  }
+  timed(Stage::Pressure, [&] {
+    dfsph_->predict(fluid_->accel(), neighbours(), dt, 1.0 / (1.0 + damping_ * dt));
+    dfsph_->density_solve(neighbours(), dt);
+    dfsph_->write_pressure(fluid_->state(), dt);
+  });
+
+  // Ice takes the reaction of the solves' pressure impulses and the forces pass's viscosity (rigid.cl).
+  if (rigid_) timed(Stage::IceForces, [&] { rigid_->compute_forces(buffers()); });
+  if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
+  timed(Stage::Integrate, [&] { dfsph_->drift(dt); });
   time_ += dt;
   dt_ = dt;
   ++steps_;

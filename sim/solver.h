@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sim/cl_runtime.h"
+#include "sim/dfsph_stage.h"
 #include "sim/emitters.h"
 #include "sim/fluid_stage.h"
 #include "sim/heat_stage.h"
@@ -159,6 +160,7 @@ class Solver {
 
   // Rigid ice (scenes with free ice; null otherwise): the bodies, labelling and its counters.
   const RigidIce* rigid_ice() const { return rigid_.get(); }
+  const DfsphStage* dfsph() const { return dfsph_.get(); }  // null unless solver.pressure is dfsph
 
   // Cell geometry of the neighbour grid (for reference loops and tests).
   using GridInfo = thaw::GridInfo;
@@ -208,6 +210,9 @@ class Solver {
   bool grid_built_ = false;
   // The water's passes (sim/fluid_stage.h), built only for scenes with flow.
   std::unique_ptr<FluidStage> fluid_;
+  // The incompressible pressure solver (sim/dfsph_stage.h), built only when solver.pressure is dfsph.
+  std::unique_ptr<DfsphStage> dfsph_;
+  void step_dfsph();
   // Particles clamped back into the domain (counted by the grid's cell-key pass).
   cl::Buffer clamped_;
 

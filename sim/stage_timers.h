@@ -9,11 +9,13 @@ namespace thaw {
 
 // IceForces and Bodies run only in scenes with free ice (sim/rigid_ice.h): the forces on ice particles,
 // and labelling, per-body sums, rigid integration and placing the ice particles. Emit runs only in scenes
-// with emitters (sim/emitters.h), and includes growing the capacity.
+// with emitters (sim/emitters.h), and includes growing the capacity. Pressure runs only with DFSPH
+// (sim/dfsph_stage.h): alpha, the divergence and density solves, and the predicted velocities.
 enum class Stage {
   Grid,
   Density,
   Forces,
+  Pressure,
   IceForces,
   TimeStep,
   Photons,
@@ -24,7 +26,7 @@ enum class Stage {
   Count
 };
 inline constexpr std::array<const char*, static_cast<int>(Stage::Count)> kStageNames = {
-    "grid", "density", "forces", "ice_forces", "time_step", "photons", "heat", "bodies", "integrate", "emit"};
+    "grid", "density", "forces", "pressure", "ice_forces", "time_step", "photons", "heat", "bodies", "integrate", "emit"};
 
 class StageTimers {
  public:

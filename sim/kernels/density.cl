@@ -39,7 +39,10 @@ kernel void density(global const float4* pos, global const float* soa, global co
     }
   })
   const float rho = THAW_SIGMA(H) * lanes_sum(acc);
-#ifdef THAW_EOS_TAIT
+#ifdef THAW_DFSPH
+  /* DFSPH (sim/kernels/dfsph.cl) solves for the pressure after the forces pass: none here. */
+  float p = 0.0f;
+#elif defined(THAW_EOS_TAIT)
   /* Tait (Monaghan 1994; Becker & Teschner 2007): p = B ((rho/rho0)^gamma - 1). */
 #ifdef THAW_GAMMA_7
   /* gamma = 7 (the usual choice) by multiplication: pocl's powr cost as much as the neighbour sum. */

@@ -265,8 +265,9 @@ async def scenario(call, js, until):
     print("moving shown", seen)
     print("settled", bool(await until(f"{HUD}.includes('fast 480×360 stretched')", 20)))
     await js("{ const s = document.getElementById('scale'); s.value = '0.5'; s.dispatchEvent(new Event('change')); }")
-    async with thaw_client.connect(URL) as other:
-        print("detail set", other.welcome["quality"]["scale"] if await until(f"{HUD}.includes('fast 320×240 stretched')", 20) else None)
+    shown = await until(f"{HUD}.includes('fast 320×240 stretched')", 20)
+    async with thaw_client.connect(URL) as other:  # after the frame: its welcome then has the new scale
+        print("detail set", other.welcome["quality"]["scale"] if shown else None)
     await js("document.getElementById('full-quality').click()")
     await asyncio.sleep(0.5)
     await call("Page.reload")

@@ -57,7 +57,7 @@ TEST_F(KernelBuild, MissingEmbeddedFileIsNamed) {
 
 TEST_F(KernelBuild, EveryEmbeddedStageBuilds) {
   for (const char* stage :
-       {"grid.cl", "boundary.cl", "density.cl", "forces.cl", "integrate.cl", "step_limits.cl", "heat.cl"})
+       {"grid.cl", "boundary.cl", "density.cl", "forces.cl", "integrate.cl", "step_limits.cl", "heat.cl", "dfsph.cl"})
     EXPECT_NO_THROW(
         cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h", "dryer_model.h",
                     "heat_params.h", "fluid_params.h", stage},

@@ -1,0 +1,150 @@
+#include "sim/dfsph_stage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "sim/cl_launch.h"
+
+namespace thaw {
+
+namespace {
+constexpr int kColumns = 5;  // FM, KR, AD, AV, ERR (sim/kernels/dfsph.cl)
+}
+
+DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
+                       double support, double spacing, const std::string& build_options,
+                       const ParticleLayout& layout, const cl::Buffer& flow)
+    : cl_(cl), store_(store), f_(core), layout_(layout), flow_(flow) {
+  // The accumulated (sum kappa dt^2, sum kappa dt) of the step's two solves: the next step's warm start,
+  // saved so that a resumed run continues bitwise.
+  kappa_ = store.add({"dfsph_kappa", FieldType::Float32, 2});
+  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph.cl"},
+                                build_options);
+  k_columns_ = cl::Kernel(program, "dfsph_columns");
+  k_alpha_ = cl::Kernel(program, "dfsph_alpha");
+  k_error_ = cl::Kernel(program, "dfsph_error");
+  k_warm_ = cl::Kernel(program, "dfsph_warm");
+  k_correct_ = cl::Kernel(program, "dfsph_correct");
+  k_sum_ = cl::Kernel(program, "dfsph_error_sum");
+  k_predict_ = cl::Kernel(program, "dfsph_predict");
+  k_drift_ = cl::Kernel(program, "dfsph_drift");
+  k_pressure_ = cl::Kernel(program, "dfsph_pressure");
+  support_ = static_cast<float>(support);
+  // A full neighbourhood holds about (4/3) pi (H / dx)^3 particles; below 60 % of it a particle is at a
+  // surface, where the divergence solve leaves it (20 of 33 at H = 2 dx, SPlisHSPlasH's threshold).
+  const double full = 4.0 / 3.0 * M_PI * std::pow(support / spacing, 3);
+  min_neighbours_ = static_cast<cl_uint>(std::lround(0.6 * full));
+  for (const Material& m : scene.materials)
+    if (m.kind == MaterialKind::Fluid) {
+      rest_density_ = m.density;
+      break;
+    }
+  density_tolerance_ = scene.solver.density_tolerance;
+  divergence_tolerance_ = scene.solver.divergence_tolerance;
+  max_iterations_ = scene.solver.max_pressure_iterations;
+  col_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::size_t(layout.stride) * kColumns * 4);
+  // Lanes read up to 15 floats past the last particle: keep the padding finite.
+  cl.queue().enqueueFillBuffer(col_, 0.0f, 0, std::size_t(layout.stride) * kColumns * 4);
+  sums_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(layout.max_tiles, 1) * 8);
+}
+
+void DfsphStage::prepare(const NeighbourView& nv) {
+  if (layout_.n == 0) return;
+  const auto n = static_cast<cl_uint>(layout_.n);
+  set_args(k_columns_, store_[f_.position], store_[f_.phase], col_, layout_.stride, n);
+  launch(cl_.queue(), k_columns_, layout_.n);
+  set_args(k_alpha_, store_[f_.position], nv.soa, store_[f_.density], store_[f_.phase], col_, nv.cell_start,
+           nv.grid, support_, min_neighbours_, layout_.stride, n);
+  launch(cl_.queue(), k_alpha_, layout_.n);
+}
+
+double DfsphStage::mean_error(double rest_density) {
+  auto& q = cl_.queue();
+  const cl_uint tiles = std::max<cl_uint>(layout_.ntiles, 1);
+  set_args(k_sum_, col_, store_[f_.phase], sums_, layout_.stride, static_cast<cl_uint>(layout_.n), layout_.tile);
+  q.enqueueNDRangeKernel(k_sum_, cl::NullRange, cl::NDRange(tiles));
+  std::vector<cl_float2> s(tiles);
+  q.enqueueReadBuffer(sums_, CL_TRUE, 0, tiles * 8, s.data());
+  double sum = 0, count = 0;
+  for (const auto& t : s) {
+    sum += t.s[0];
+    count += t.s[1];
+  }
+  return count > 0 ? sum / count / rest_density : 0.0;
+}
+
+PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density_mode) {
+  PressureSolve out;
+  if (layout_.n == 0 || !(dt > 0)) return out;
+  auto& q = cl_.queue();
+  const auto n = static_cast<cl_uint>(layout_.n);
+  const float fdt = static_cast<float>(dt);
+  const cl_int mode = density_mode ? 1 : 0;
+  // Warm start: apply last step's accumulated kappa, which stays in the accumulator.
+  set_args(k_warm_, store_[f_.density], store_[f_.phase], col_, store_[kappa_], fdt, mode, layout_.stride, n);
+  launch(q, k_warm_, layout_.n);
+  set_args(k_correct_, store_[f_.velocity], nv.soa, store_[f_.phase], col_, store_[f_.position],
+           store_[f_.density], store_[kappa_], nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride, n);
+  launch(q, k_correct_, layout_.n);
+  set_args(k_error_, store_[f_.position], nv.soa, store_[f_.density], store_[f_.phase], store_[f_.material], flow_,
+           col_, nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride, n);
+  // The density error is (rho* - rho0), the divergence error D rho / Dt; both as fractions of rho0, the
+  // second over one step.
+  const double scale = density_mode ? 1.0 : dt;
+  const double tolerance = density_mode ? density_tolerance_ : divergence_tolerance_;
+  for (;;) {
+    launch(q, k_error_, layout_.n);
+    out.error = mean_error(rest_density_) * scale;
+    // At least two sweeps (Bender & Koschier 2017, Algorithm 2 and 3).
+    if (out.iterations >= 2 && out.error <= tolerance) break;
+    if (out.iterations >= max_iterations_) {
+      out.converged = false;
+      break;
+    }
+    launch(q, k_correct_, layout_.n);
+    ++out.iterations;
+  }
+  return out;
+}
+
+PressureSolve DfsphStage::divergence_solve(const NeighbourView& nv, double dt) {
+  last_divergence_ = solve(nv, dt, false);
+  totals_.divergence_iterations += std::uint64_t(last_divergence_.iterations);
+  if (!last_divergence_.converged) ++totals_.divergence_unconverged;
+  return last_divergence_;
+}
+
+void DfsphStage::predict(const cl::Buffer& accel, const NeighbourView& nv, double dt, double damping_factor) {
+  if (layout_.n == 0) return;
+  set_args(k_predict_, store_[f_.velocity], nv.soa, accel, store_[f_.phase], static_cast<float>(dt),
+           static_cast<float>(damping_factor), layout_.stride, static_cast<cl_uint>(layout_.n));
+  launch(cl_.queue(), k_predict_, layout_.n);
+}
+
+PressureSolve DfsphStage::density_solve(const NeighbourView& nv, double dt) {
+  last_density_ = solve(nv, dt, true);
+  ++totals_.steps;
+  totals_.density_iterations += std::uint64_t(last_density_.iterations);
+  if (!last_density_.converged) {
+    ++totals_.density_unconverged;
+    totals_.worst_density_error = std::max(totals_.worst_density_error, last_density_.error);
+  }
+  return last_density_;
+}
+
+void DfsphStage::write_pressure(const cl::Buffer& state, double dt) {
+  if (layout_.n == 0) return;
+  set_args(k_pressure_, store_[f_.density], store_[f_.phase], store_[kappa_], state, static_cast<float>(dt),
+           static_cast<cl_uint>(layout_.n));
+  launch(cl_.queue(), k_pressure_, layout_.n);
+}
+
+void DfsphStage::drift(double dt) {
+  if (layout_.n == 0) return;
+  set_args(k_drift_, store_[f_.position], store_[f_.velocity], store_[f_.phase], static_cast<float>(dt),
+           static_cast<cl_uint>(layout_.n));
+  launch(cl_.queue(), k_drift_, layout_.n);
+}
+
+}  // namespace thaw

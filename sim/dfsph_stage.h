@@ -1,0 +1,83 @@
+#pragma once
+// Divergence-free SPH (Bender & Koschier 2015, 2017): the pressure solver of `solver.pressure: "dfsph"`.
+// The fluid stage's density pass (without an equation of state) and forces pass (viscosity, gravity, the
+// walls' push) stay; this stage replaces the pressure force by two Jacobi solves on the velocities, each
+// warm-started from the last step and stopped at its tolerance or the iteration cap
+// (sim/kernels/dfsph.cl has the equations). The step (Solver::step, 2017 Algorithm 1):
+//   grid, densities, alpha -> divergence solve (last step's dt) -> non-pressure forces -> dt from the
+//   velocity CFL -> v += dt a -> density solve -> x += dt v.
+// Built only for scenes that ask for it.
+#include <CL/opencl.hpp>
+#include <cstdint>
+#include <string>
+
+#include "sim/cl_runtime.h"
+#include "sim/particle_store.h"
+#include "sim/scene.h"
+#include "sim/stage.h"
+
+namespace thaw {
+
+// One solve of one step: iterations done, the mean error when it stopped (density: mean (rho* - rho0) /
+// rho0; divergence: mean (D rho / Dt) dt / rho0) and whether that met the tolerance.
+struct PressureSolve {
+  int iterations = 0;
+  double error = 0;
+  bool converged = true;
+};
+
+// Counts over a run, for the metrics and the run's warning: steps whose solve stopped at the cap.
+struct PressureSolveTotals {
+  std::uint64_t steps = 0, density_iterations = 0, divergence_iterations = 0;
+  std::uint64_t density_unconverged = 0, divergence_unconverged = 0;
+  double worst_density_error = 0;  // of the unconverged steps
+};
+
+class DfsphStage {
+ public:
+  // `flow` is the fluid stage's material table (rest densities); `density` the fluid stage's field.
+  DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene, double support,
+             double spacing, const std::string& build_options, const ParticleLayout& layout,
+             const cl::Buffer& flow);
+
+  // After the density pass: who is fluid, and alpha for both solves.
+  void prepare(const NeighbourView& nv);
+  // Makes the velocities divergence-free with the step that produced them (dt: the last step's; none
+  // before the first step).
+  PressureSolve divergence_solve(const NeighbourView& nv, double dt);
+  // v += dt a (non-pressure accelerations), damped by damping_factor.
+  void predict(const cl::Buffer& accel, const NeighbourView& nv, double dt, double damping_factor);
+  PressureSolve density_solve(const NeighbourView& nv, double dt);
+  // The step's pressure into the fluid stage's state buffer (rho, p / rho^2, boundary, p), as rigid ice
+  // and the metrics read it.
+  void write_pressure(const cl::Buffer& state, double dt);
+  void drift(double dt);
+
+  const PressureSolve& last_density() const { return last_density_; }
+  const PressureSolve& last_divergence() const { return last_divergence_; }
+  const PressureSolveTotals& totals() const { return totals_; }
+
+ private:
+  // Runs one solve: warm start, then error / correct sweeps until the mean error is within tolerance
+  // (after at least two sweeps) or the cap.
+  PressureSolve solve(const NeighbourView& nv, double dt, bool density_mode);
+  double mean_error(double rest_density);
+
+  ClRuntime& cl_;
+  ParticleStore& store_;
+  CoreFields f_;
+  const ParticleLayout& layout_;
+  const cl::Buffer& flow_;
+  ParticleStore::Field kappa_ = 0;
+  float support_ = 0;
+  cl_uint min_neighbours_ = 0;
+  double rest_density_ = 1000;
+  double density_tolerance_ = 0, divergence_tolerance_ = 0;
+  int max_iterations_ = 100;
+  cl::Kernel k_columns_, k_alpha_, k_error_, k_warm_, k_correct_, k_sum_, k_predict_, k_drift_, k_pressure_;
+  cl::Buffer col_, sums_;
+  PressureSolve last_density_, last_divergence_;
+  PressureSolveTotals totals_;
+};
+
+}  // namespace thaw

@@ -1,0 +1,272 @@
+/* Divergence-free SPH (Bender & Koschier 2015, "Divergence-Free Smoothed Particle Hydrodynamics", and
+ * 2017, "Divergence-Free SPH for Incompressible and Viscous Fluids", Algorithms 1-3): two Jacobi solves
+ * per step on the fluid's velocities, one that makes the velocity field divergence-free (Dρ/Dt = 0) and
+ * one that brings the predicted density back to the rest density. sim/dfsph_stage.cpp drives them.
+ *
+ * Notation (2017 eqs 9-12): the pressure force of pair ij is -m_i m_j (κ_i/ρ_i + κ_j/ρ_j) ∇W_ij, so κ_i/ρ_i
+ * plays p_i/ρ_i² (p_i = κ_i ρ_i). Boundary particles (static solids and ice, Akinci et al. 2012: mass Ψ_b)
+ * enter one-sided, κ_b = 0, as in the 2017 paper's boundary handling; the solve, not the boundary's own
+ * pressure, makes the wall hold the fluid. With ∇W_ij = gf(r) x_ij and
+ *   G_i = Σ_j m_j ∇W_ij (fluid and boundary),  S_i = m_i Σ_{j fluid} m_j |∇W_ij|²,
+ * a change κ_i of one particle alone changes its density by -dt² κ_i/ρ_i (|G_i|² + S_i), hence
+ *   α_i = ρ_i / (|G_i|² + S_i)                                           (2015 eq 10, mixed masses)
+ *   density solve:    κ_i = (ρ*_i - ρ0) α_i / dt²,  ρ*_i = ρ_i + dt Σ_j m_j (v_i - v_j)·∇W_ij   (eq 12)
+ *   divergence solve: κ_i = (Dρ/Dt)_i α_i / dt                                               (eq 14)
+ *   velocity update:  v_i -= dt Σ_j m_j (κ_i/ρ_i + κ_j/ρ_j) ∇W_ij                             (eq 9)
+ * Only compression is corrected (ρ* and Dρ/Dt clamped at zero error from below): a free surface is not
+ * pulled together. The divergence solve leaves particles with fewer than min_neighbours neighbours alone
+ * (their density deficit is the surface's, not a flow's), as SPlisHSPlasH's implementation does.
+ *
+ * Per-particle columns (blocks of `stride` floats in `col`, read on SIMD lanes like the reorder's soa):
+ *   FM    m_j for fluid particles, 0 for boundary ones
+ *   KR    κ_j / ρ_j of the current iteration (0 for boundary particles)
+ *   AD    α_j for the density solve, AV α_j for the divergence solve (0 where it is not solved)
+ *   ERR   this iteration's error: ρ* - ρ0 or Dρ/Dt (≥ 0; 0 for boundary particles)
+ * and the saved field `kappa` (sim/dfsph_stage.cpp): the step's accumulated (Σ κ dt², Σ κ dt) of the two
+ * solves, dt-free, which warm-start the next step (2017 §4.3) and make a resumed run bitwise the same. */
+
+/* The share of last step's κ the warm start applies. All of it ratchets: the solves only add (they correct
+ * compression, never expansion), so a warm start that overshoots is never taken back, and the hydrostatic
+ * tank's kinetic energy grew tenfold every 10 ms until it blew up. Half, as SPlisHSPlasH's implementation
+ * does, decays what is no longer needed geometrically. */
+#ifndef THAW_WARM
+#define THAW_WARM 0.5f
+#endif
+
+#define COL_FM 0
+#define COL_KR 1
+#define COL_AD 2
+#define COL_AV 3
+#define COL_ERR 4
+
+/* FM: who is fluid, as the lanes of the other passes read it. */
+kernel void dfsph_columns(global const float4* pos, global const uchar* phase, global float* col, const uint stride,
+                          const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  col[COL_FM * stride + i] = THAW_IS_STATIC(phase[i]) ? 0.0f : pos[i].w;
+  col[COL_KR * stride + i] = 0.0f;
+}
+
+/* α_i for both solves, from the densities of the density pass. */
+kernel void dfsph_alpha(global const float4* pos, global const float* soa, global const float* density,
+                        global const uchar* phase, global float* col, global const uint* cell_start, const Grid g,
+                        const float H, const uint min_neighbours, const uint stride, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  if (THAW_IS_STATIC(phase[i])) {
+    col[COL_AD * stride + i] = 0.0f;
+    col[COL_AV * stride + i] = 0.0f;
+    col[COL_ERR * stride + i] = 0.0f;
+    return;
+  }
+  const float4 pi = pos[i];
+  const int4 c = grid_cell(g, pi);
+  const float H2 = H * H, inv_H = 1.0f / H;
+  global const float* X = soa;
+  global const float* Y = soa + stride;
+  global const float* Z = soa + 2 * stride;
+  global const float* M = soa + 3 * stride;
+  global const float* FM = col + COL_FM * stride;
+  floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
+  floatV count = (floatV)(0.0f);
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+    for (uint j = jb; j < je; j += THAW_VW) {
+      const floatV dx = pi.x - vloadV(0, X + j);
+      const floatV dy = pi.y - vloadV(0, Y + j);
+      const floatV dz = pi.z - vloadV(0, Z + j);
+      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV gf = grad_shape(sqrt(r2) * inv_H); /* ∇W = sigma/H² gf x_ij; the factor comes last */
+      const floatV mg = vloadV(0, M + j) * gf;
+      gx += select((floatV)(0.0f), mg * dx, in);
+      gy += select((floatV)(0.0f), mg * dy, in);
+      gz += select((floatV)(0.0f), mg * dz, in);
+      s += select((floatV)(0.0f), vloadV(0, FM + j) * gf * gf * r2, in);
+      count += select((floatV)(0.0f), (floatV)(1.0f), in);
+    }
+  })
+  const float scale = THAW_SIGMA(H) * inv_H * inv_H;
+  const float3 G = scale * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
+  const float S = pi.w * scale * scale * lanes_sum(s);
+  const float d = dot(G, G) + S;
+  /* A particle without neighbours (d = 0) cannot be corrected by its own pressure: leave it alone. */
+  const float alpha = d > 0.0f ? density[i] / d : 0.0f;
+  const float neighbours = lanes_sum(count);
+  col[COL_AD * stride + i] = alpha;
+  col[COL_AV * stride + i] = neighbours - 1.0f >= (float)min_neighbours ? alpha : 0.0f; /* -1: itself */
+}
+
+/* Σ_j m_j (v_i - v_j)·∇W_ij over every neighbour (boundary particles move with their body or not at all). */
+float density_rate(const float4 pi, const float3 vi, global const float* soa, global const uint* cell_start,
+                   const Grid g, const float H, const uint stride) {
+  const int4 c = grid_cell(g, pi);
+  const float H2 = H * H, inv_H = 1.0f / H;
+  global const float* X = soa;
+  global const float* Y = soa + stride;
+  global const float* Z = soa + 2 * stride;
+  global const float* M = soa + 3 * stride;
+  global const float* VX = soa + 4 * stride;
+  global const float* VY = soa + 5 * stride;
+  global const float* VZ = soa + 6 * stride;
+  floatV acc = (floatV)(0.0f);
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+    for (uint j = jb; j < je; j += THAW_VW) {
+      const floatV dx = pi.x - vloadV(0, X + j);
+      const floatV dy = pi.y - vloadV(0, Y + j);
+      const floatV dz = pi.z - vloadV(0, Z + j);
+      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
+                        (vi.z - vloadV(0, VZ + j)) * dz;
+      const floatV t = vloadV(0, M + j) * grad_shape(sqrt(r2) * inv_H) * vd;
+      acc += select((floatV)(0.0f), t, in);
+    }
+  })
+  return THAW_SIGMA(H) * inv_H * inv_H * lanes_sum(acc);
+}
+
+/* One Jacobi sweep's first half: each fluid particle's error and κ, from the velocities as they are.
+ * density_mode 1: the density solve (dt this step's); 0: the divergence solve. */
+kernel void dfsph_error(global const float4* pos, global const float* soa, global const float* density,
+                        global const uchar* phase, global const uchar* material, global const MaterialFlow* flow,
+                        global float* col, global const uint* cell_start, const Grid g, const float H,
+                        const float dt, const int density_mode, const uint stride, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  if (THAW_IS_STATIC(phase[i])) return; /* their KR and ERR stay 0 (dfsph_columns, dfsph_alpha) */
+  const float4 pi = pos[i];
+  const float3 vi = (float3)(soa[4 * stride + i], soa[5 * stride + i], soa[6 * stride + i]);
+  const float rate = density_rate(pi, vi, soa, cell_start, g, H, stride);
+  const float rho = density[i];
+  float err, k;
+  if (density_mode) {
+    const float rho0 = flow[material[i]].rest_density;
+    err = fmax(rho + dt * rate - rho0, 0.0f);
+    k = err * col[COL_AD * stride + i] / (dt * dt);
+  } else {
+    const float a = col[COL_AV * stride + i];
+    err = a > 0.0f ? fmax(rate, 0.0f) : 0.0f;
+    k = err * a / dt;
+  }
+  col[COL_KR * stride + i] = k / rho;
+  col[COL_ERR * stride + i] = err;
+}
+
+/* The warm start (2017 §4.3): last step's accumulated κ of this solve as this iteration's KR; the
+ * accumulator starts again from zero, and dfsph_correct adds back what it applies. */
+kernel void dfsph_warm(global const float* density, global const uchar* phase, global float* col,
+                       global float2* kappa, const float dt, const int density_mode, const uint stride,
+                       const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  if (THAW_IS_STATIC(phase[i])) return;
+  float2 acc = kappa[i];
+  const float k = THAW_WARM * (density_mode ? acc.x / (dt * dt) : acc.y / dt);
+  col[COL_KR * stride + i] = k / density[i];
+  if (density_mode)
+    acc.x = 0.0f;
+  else
+    acc.y = 0.0f;
+  kappa[i] = acc;
+}
+
+/* The second half: v_i -= dt Σ_j m_j (KR_i + KR_j) ∇W_ij, written to vel and to the soa copy the lanes
+ * read. Boundary neighbours have KR = 0: one-sided with their Ψ. The κ applied is added to the
+ * accumulator: κ dt² (density_mode) or κ dt. */
+kernel void dfsph_correct(global float4* vel, global float* soa, global const uchar* phase, global const float* col,
+                          global const float4* pos, global const float* density, global float2* kappa,
+                          global const uint* cell_start, const Grid g, const float H, const float dt,
+                          const int density_mode, const uint stride, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  if (THAW_IS_STATIC(phase[i])) return;
+  const float4 pi = pos[i];
+  const int4 c = grid_cell(g, pi);
+  const float H2 = H * H, inv_H = 1.0f / H;
+  global const float* X = soa;
+  global const float* Y = soa + stride;
+  global const float* Z = soa + 2 * stride;
+  global const float* M = soa + 3 * stride;
+  global const float* KR = col + COL_KR * stride;
+  const float kri = KR[i];
+  floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+    for (uint j = jb; j < je; j += THAW_VW) {
+      const floatV dx = pi.x - vloadV(0, X + j);
+      const floatV dy = pi.y - vloadV(0, Y + j);
+      const floatV dz = pi.z - vloadV(0, Z + j);
+      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV t = vloadV(0, M + j) * (kri + vloadV(0, KR + j)) * grad_shape(sqrt(r2) * inv_H);
+      ax += select((floatV)(0.0f), t * dx, in);
+      ay += select((floatV)(0.0f), t * dy, in);
+      az += select((floatV)(0.0f), t * dz, in);
+    }
+  })
+  const float3 dv = -dt * THAW_SIGMA(H) * inv_H * inv_H * (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
+  const float3 v = vel[i].xyz + dv;
+  vel[i] = (float4)(v, 0.0f);
+  soa[4 * stride + i] = v.x;
+  soa[5 * stride + i] = v.y;
+  soa[6 * stride + i] = v.z;
+  float2 acc = kappa[i];
+  const float applied = kri * density[i] * (density_mode ? dt * dt : dt);
+  if (density_mode)
+    acc.x += applied;
+  else
+    acc.y += applied;
+  kappa[i] = acc;
+}
+
+/* Per tile: the sum of the errors over fluid particles, and their count (deterministic, unlike atomics). */
+kernel void dfsph_error_sum(global const float* col, global const uchar* phase, global float2* sums,
+                            const uint stride, const uint n, const uint tile) {
+  const uint t = get_global_id(0);
+  const uint b = t * tile, e = min(b + tile, n);
+  float sum = 0.0f, count = 0.0f;
+  for (uint i = b; i < e; ++i) {
+    if (THAW_IS_STATIC(phase[i])) continue;
+    sum += col[COL_ERR * stride + i];
+    count += 1.0f;
+  }
+  sums[t] = (float2)(sum, count);
+}
+
+/* v += dt a (the non-pressure forces), before the density solve; soa too. */
+kernel void dfsph_predict(global float4* vel, global float* soa, global const float4* accel, global const uchar* phase,
+                          const float dt, const float damping_factor, const uint stride, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n || THAW_IS_STATIC(phase[i])) return;
+  const float3 v = (vel[i].xyz + accel[i].xyz * dt) * damping_factor;
+  vel[i] = (float4)(v, 0.0f);
+  soa[4 * stride + i] = v.x;
+  soa[5 * stride + i] = v.y;
+  soa[6 * stride + i] = v.z;
+}
+
+/* x += dt v with the corrected velocities. */
+kernel void dfsph_drift(global float4* pos, global const float4* vel, global const uchar* phase, const float dt,
+                        const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n || THAW_IS_STATIC(phase[i])) return;
+  pos[i] = (float4)(pos[i].xyz + vel[i].xyz * dt, pos[i].w);
+}
+
+/* The step's pressure as the rest of the solver reads it (state = (ρ, p/ρ², is_boundary, p), as density.cl
+ * writes it for WCSPH): the two solves' impulses over this step's dt, dp = (Σκ dt + Σκ dt² / dt) / (dt ρ),
+ * so rigid ice (rigid.cl) takes exactly the reaction of what the fluid received from its particles.
+ * Boundary particles: dp = 0 (one-sided). */
+kernel void dfsph_pressure(global const float* density, global const uchar* phase, global const float2* kappa,
+                           global float4* state, const float dt, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  const float rho = density[i];
+  if (THAW_IS_STATIC(phase[i])) {
+    state[i] = (float4)(rho, 0.0f, 1.0f, 0.0f);
+    return;
+  }
+  const float2 acc = kappa[i];
+  const float dp = dt > 0.0f ? (acc.y + acc.x / dt) / (dt * rho) : 0.0f;
+  state[i] = (float4)(rho, dp, 0.0f, dp * rho * rho);
+}
