@@ -499,6 +499,15 @@ Scene convert_and_check(Json doc, const std::string& folder) {
                                     "; increase the spacing, shrink the scene, or set THAW_MEMORY_LIMIT "
                                     "(e.g. THAW_MEMORY_LIMIT=32G, or off) to override");
   }
+  // DFSPH hands rigid ice the reaction of its solves' impulses, but that coupling does not float ice yet
+  // (`thaw validate floating --set solver.pressure=dfsph`: the prism sank to a draft of 1.47 of its height
+  // against 0.917): refuse it rather than sink the user's ice.
+  if (s.solver.pressure == PressureSolver::Dfsph)
+    for (std::size_t b = 0; b < s.ice.size(); ++b)
+      if (s.ice[b].motion == IceBlock::Motion::Free)
+        throw SceneError("solver.pressure", "dfsph does not float free ice yet (ice[" + std::to_string(b) +
+                                                "] has motion free; in the floating case the prism sank): use "
+                                                "wcsph for scenes with free ice, or make the ice fixed");
   if (s.solver.min_dt >= s.solver.max_dt) {
     throw SceneError("solver.min_dt", format_number(s.solver.min_dt) + " s must be below solver.max_dt (" +
                                           format_number(s.solver.max_dt) + " s)");

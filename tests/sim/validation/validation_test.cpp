@@ -70,24 +70,39 @@ TEST_F(Validation, HydrostaticReferenceFollowsOverriddenParameters) {
 // resolutions 10 to 30: see docs/VALIDATION-RESULTS.md), by about 0.2-0.3 in T*; the experiment's gate
 // took time to open. What is asserted is what holds: the front advances, never strays 20 % from the
 // data, is inside the gate at T* = 3, and runs at the data's speed over the window.
-TEST_F(Validation, DamBreakFrontFollowsMartinMoyce) {
-  const CaseResult r = run_validation(cl(), "dam-break", 16, {});
-  print(r);
-  ASSERT_GE(r.metrics.size(), 4u);
-  double previous = 1.0;
-  const auto positions = std::vector(r.metrics.begin(), r.metrics.end() - 1);
-  for (const auto& [key, m] : positions) {
-    EXPECT_EQ(key.rfind("front_Z/a_at_T*=", 0), 0u) << key;
-    EXPECT_TRUE(std::isfinite(m.value)) << key;
-    EXPECT_GT(m.value, previous) << key << ": the front only advances";
-    previous = m.value;
-    EXPECT_LT(m.error, 0.2) << key;
+// The dam break against Martin & Moyce with both pressure solvers at the case's resolution, 20 particles
+// across the column (issue 17's gate; at 16, WCSPH's front at T* = 1.219 is 5.9 % off, 0.09 a, within the
+// digitized data's 0.1-0.15 a): the front leads the
+// data by a start-time shift dT* in [0, 0.3] (their gate took time to open), and after that shift every
+// compared position is within 5 % and the front only advances; its speed over the window within 10 %. A
+// window that leaves the measured shift out fails on the shift alone.
+TEST_F(Validation, DamBreakFrontFollowsMartinMoyceAfterTheGatesOpeningTime) {
+  for (const char* pressure : {"solver.pressure=wcsph", "solver.pressure=dfsph"}) {
+    const CaseResult r = run_validation(cl(), "dam-break", 20, {pressure});
+    print(r);
+    EXPECT_TRUE(r.passed()) << pressure;
+    ASSERT_GE(r.metrics.size(), 4u);
+    EXPECT_EQ(r.metrics.front().first, "front_time_shift_dT*");
+    const double shift = r.metrics.front().second.value;
+    EXPECT_GE(shift, 0.0) << pressure;
+    EXPECT_LE(shift, 0.3) << pressure;
+    double previous = 1.0;
+    for (auto it = r.metrics.begin() + 1; it + 1 != r.metrics.end(); ++it) {
+      const auto& [key, m] = *it;
+      EXPECT_EQ(key.rfind("front_Z/a_at_T*=", 0), 0u) << key;
+      EXPECT_NE(key.find("_shifted"), std::string::npos) << key;
+      EXPECT_TRUE(std::isfinite(m.value)) << key;
+      EXPECT_GT(m.value, previous) << key << ": the front only advances";
+      previous = m.value;
+      EXPECT_LE(m.error, 0.05) << pressure << " " << key;
+    }
+    const auto& [speed_key, speed] = r.metrics.back();
+    EXPECT_EQ(speed_key, "front_speed_dZ/dT*");
+    EXPECT_LE(speed.error, speed.gate) << speed.value << " against " << speed.reference;
   }
-  EXPECT_LE(positions.back().second.error, positions.back().second.gate) << positions.back().first;
-  // The front runs at the experiment's pace over the window, wherever it started from.
-  const auto& [speed_key, speed] = r.metrics.back();
-  EXPECT_EQ(speed_key, "front_speed_dZ/dT*");
-  EXPECT_LE(speed.error, speed.gate) << speed.value << " against " << speed.reference;
+  const CaseResult narrow = run_validation(cl(), "dam-break", 20, {"solver.pressure=dfsph", "shift_max=0.1"});
+  EXPECT_FALSE(narrow.passed());
+  EXPECT_FALSE(narrow.metrics.front().second.passed()) << narrow.metrics.front().second.value;
 }
 
 TEST_F(Validation, ConductionPassesOnOrderedAndJitteredParticles) {
