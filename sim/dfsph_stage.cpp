@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <vector>
 
 #include "sim/cl_launch.h"
@@ -19,8 +20,11 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   // The accumulated (sum kappa dt^2, sum kappa dt) of the step's two solves: the next step's warm start,
   // saved so that a resumed run continues bitwise.
   kappa_ = store.add({"dfsph_kappa", FieldType::Float32, 2});
+  std::ostringstream relaxation;
+  relaxation.precision(9);
+  relaxation << build_options << " -DTHAW_OMEGA=" << scene.solver.pressure_relaxation << "f";
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph.cl"},
-                                build_options);
+                                relaxation.str());
   k_columns_ = cl::Kernel(program, "dfsph_columns");
   k_alpha_ = cl::Kernel(program, "dfsph_alpha");
   k_error_ = cl::Kernel(program, "dfsph_error");
@@ -96,7 +100,9 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
   for (;;) {
     launch(q, k_error_, layout_.n);
     out.error = mean_error(rest_density_) * scale;
-    // At least two sweeps (Bender & Koschier 2017, Algorithm 2 and 3).
+    // At least two corrections each (Bender & Koschier 2017, Algorithms 2 and 3), then until the
+    // tolerance. One for the divergence saved 12 % of the step in the dam break but slowed its front (dZ/dT*
+    // 1.100 against the data's 1.156) past the position gate at T* = 1.219 (6.1 %).
     if (out.iterations >= 2 && out.error <= tolerance) break;
     if (out.iterations >= max_iterations_) {
       out.converged = false;

@@ -499,15 +499,16 @@ Scene convert_and_check(Json doc, const std::string& folder) {
                                     "; increase the spacing, shrink the scene, or set THAW_MEMORY_LIMIT "
                                     "(e.g. THAW_MEMORY_LIMIT=32G, or off) to override");
   }
-  // DFSPH hands rigid ice the reaction of its solves' impulses, but that coupling does not float ice yet
-  // (`thaw validate floating --set solver.pressure=dfsph`: the prism sank to a draft of 1.47 of its height
-  // against 0.917): refuse it rather than sink the user's ice.
+  // DFSPH hands rigid ice the reaction of its solves' impulses, but that coupling does not float ice
+  // within its gates yet (`thaw validate floating --set solver.pressure=dfsph`: draft 0.899 of the height
+  // below the water surface, 0.990 below the water's mass level, against 0.917): refuse it rather than
+  // give the user's ice a wrong draft.
   if (s.solver.pressure == PressureSolver::Dfsph)
     for (std::size_t b = 0; b < s.ice.size(); ++b)
       if (s.ice[b].motion == IceBlock::Motion::Free)
         throw SceneError("solver.pressure", "dfsph does not float free ice yet (ice[" + std::to_string(b) +
-                                                "] has motion free; in the floating case the prism sank): use "
-                                                "wcsph for scenes with free ice, or make the ice fixed");
+                                                "] has motion free; in the floating case its draft is 8 % off): "
+                                                "use wcsph for scenes with free ice, or make the ice fixed");
   if (s.solver.min_dt >= s.solver.max_dt) {
     throw SceneError("solver.min_dt", format_number(s.solver.min_dt) + " s must be below solver.max_dt (" +
                                           format_number(s.solver.max_dt) + " s)");
@@ -719,6 +720,7 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.density_tolerance = j["density_tolerance"].get<double>();
   s.divergence_tolerance = j["divergence_tolerance"].get<double>();
   s.max_pressure_iterations = j["max_pressure_iterations"].get<int>();
+  s.pressure_relaxation = j["pressure_relaxation"].get<double>();
   s.eos = choice_of<Eos>(j["eos"], {Eos::Tait, Eos::Linear});
   s.gamma = j["gamma"].get<double>();
   s.speed_of_sound = j["speed_of_sound"].get<double>();

@@ -140,6 +140,7 @@ struct SolverSettings {
   double density_tolerance = 0.001;     // dfsph: mean (rho - rho0) / rho0 the density solve stops at
   double divergence_tolerance = 0.001;  // dfsph: mean (D rho / Dt) dt / rho0 the divergence solve stops at
   int max_pressure_iterations = 100;    // dfsph: per solve and step
+  double pressure_relaxation = 0.5;     // dfsph: the relaxed Jacobi's omega (sim/kernels/dfsph.cl)
   Eos eos = Eos::Tait;
   double gamma = 7.0;                  // Tait exponent
   double speed_of_sound = 0.0;         // [m/s]; 0 = sound_speed_factor * reference_speed

@@ -36,6 +36,12 @@ const Field& solver_schema() {
               .def(100)
               .at_least(2)
               .at_most(10000),
+          number("pressure_relaxation",
+                 "dfsph: relaxed Jacobi omega, the share of each particle's own correction a sweep applies "
+                 "(0.5 as IISPH; 1 is Bender & Koschier's plain Jacobi)")
+              .def(0.5)
+              .above(0)
+              .at_most(1),
           choice("eos", {"tait", "linear"}, "Equation of state: Tait (stiff) or linear in density")
               .def("tait"),
           number("gamma", "Tait exponent").def(7.0).at_least(1).at_most(10),

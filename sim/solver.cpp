@@ -691,6 +691,7 @@ bool Solver::set_emitter(std::size_t index, const Emitter& e) {
 std::vector<std::string> Solver::stages() const {
   std::vector<std::string> out = {"grid"};
   if (fluid_) out.insert(out.end(), {"density", "forces"});
+  if (dfsph_) out.push_back("pressure (dfsph)");
   if (rigid_) out.push_back("rigid ice");
   out.push_back("time step");
   if (heat_ && heat_->tracing_photons()) out.push_back("photons");
