@@ -426,16 +426,18 @@ void add_cup(DensityFields& f, std::vector<float>& phase, const Vector3f& lo, co
 // Glass shows what it holds: an ice sphere in a glass cup, seen from the side through the wall, changes
 // nearly as many pixels against the empty cup as the sphere alone covers against the background, in full
 // and in fast quality; in a cup of an opaque solid the same sphere changes none (the wall hides it). The
-// glass itself is visible: the empty cup differs from the background.
+// glass itself is visible: the empty cup differs from the background. Water in the cup shows the same way
+// (the glass box's interior is visible with and without water in it), and an opaque cup hides it.
 TEST_F(RenderTest, IceInAGlassCupShowsThroughItsWalls) {
   const Vector3f lo(-0.08f, -0.08f, -0.06f), hi(0.08f, 0.08f, 0.10f);
   const OrbitCamera camera = centred_camera(0.7, 160, 120);  // 15 degrees up: the rim hides the inside
   const Image bg = background(camera);
-  auto render_cup = [&](bool glass, bool ice) {
+  auto render_cup = [&](bool glass, bool ice, bool water = false) {
     DensityFields f = empty_fields(Vector3f(-0.12f, -0.12f, -0.10f), Vector3f(0.12f, 0.12f, 0.12f), 64);
     f.glass.assign(f.grid.size(), 0.0f);
     add_cup(f, glass ? f.glass : f.solid, lo, hi, 0.015f);
     if (ice) add_body(f, f.ice, sphere({0.0f, 0.0f, -0.01f}, 0.05f), 2.0f * f.grid.cell);
+    if (water) add_body(f, f.water, box(lo, Vector3f(hi.x(), hi.y(), 0.02f)), 2.0f * f.grid.cell);
     return renderer().render(f, camera);
   };
   const auto changed = [](const Image& a, const Image& b) { return changed_pixels(a, b, 6); };
@@ -456,6 +458,12 @@ TEST_F(RenderTest, IceInAGlassCupShowsThroughItsWalls) {
     EXPECT_GT(through_glass, 0.8 * double(sphere_pixels)) << "the sphere shows through the glass";
     EXPECT_LT(through_solid, 50) << "an opaque wall hides it";
     EXPECT_GT(changed(bg, glass_empty), 1000) << "the glass itself shows";
+    const long water_in_glass = changed(glass_empty, render_cup(true, false, true)),
+               water_in_solid = changed(solid_empty, render_cup(false, false, true));
+    std::printf("[ info ] pixels water in the cup changes: in glass %ld, in an opaque cup %ld\n", water_in_glass,
+                water_in_solid);
+    EXPECT_GT(water_in_glass, sphere_pixels) << "the water in the glass shows";
+    EXPECT_LT(water_in_solid, 50) << "an opaque wall hides it";
   }
   renderer().set_quality(SurfaceRenderer::Quality::Full);
 }
