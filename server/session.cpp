@@ -750,6 +750,8 @@ void Session::publish() {
       stats["outflow"] = {{"particles", out.particles}, {"mass", out.mass}, {"enthalpy", m.budget.outflow}};
     if (const InflowBooks in = solver_->inflow(); in.particles)
       stats["inflow"] = {{"particles", in.particles}, {"mass", in.mass}, {"enthalpy", m.budget.inflow}};
+    // DFSPH: the last step's solves and the run's counts, as the metrics carry them.
+    if (Json d = pressure_solve_json(*solver_); !d.is_null()) stats["dfsph"] = std::move(d);
     if (m.heat) {
       const EnergyBudget& b = m.budget;
       const double gross =

@@ -426,6 +426,25 @@ TEST_F(SessionTest, StatsCarryTheWaterThatRanOutThroughAnOpenSide) {
   EXPECT_EQ((*stats)["particles"]["water"].get<std::size_t>() + out["particles"].get<std::size_t>(), water);
 }
 
+// The same with DFSPH: water runs out through the open side with every particle accounted for, and the
+// stats carry the pressure solves.
+TEST_F(SessionTest, DfsphRunsLiveWithItsSolvesInTheStatsAndWaterRunsOut) {
+  auto s = make("dam-break", {"spacing=0.02", "solver.pressure=dfsph", "domain.walls=[\"-x\", \"-y\", \"+y\", \"-z\"]",
+                              "domain.open=[\"+x\"]"});
+  const std::size_t water = initial_state(*s->scene()).particles.count(Phase::Water);
+  s->start();
+  const auto stats = wait_for_stats(
+      *s, [](const Json& j) { return j.contains("outflow") && j.contains("dfsph"); }, 120s);
+  ASSERT_TRUE(stats->contains("dfsph")) << stats->dump();
+  const Json& d = (*stats)["dfsph"];
+  EXPECT_GE(d["density"]["iterations"].get<int>(), 2);
+  EXPECT_LE(d["density"]["error"].get<double>(), d["density"]["tolerance"].get<double>());
+  EXPECT_EQ(d["unconverged_density_steps"].get<int>(), 0);
+  ASSERT_TRUE(stats->contains("outflow")) << stats->dump();
+  EXPECT_EQ((*stats)["particles"]["water"].get<std::size_t>() + (*stats)["outflow"]["particles"].get<std::size_t>(),
+            water);
+}
+
 TEST_F(SessionTest, BlowUpPausesAndReportsWithoutCrashing) {
   // A block thrown down at 1 m/s under a speed limit of 1.02 m/s: gravity breaks the limit within
   // a few milliseconds of simulated time.
