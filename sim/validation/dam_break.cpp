@@ -57,6 +57,11 @@ Field params() {
               number("shifted_gate", "Gate on |Z - Z_ref| / Z_ref at each compared time, after the shift")
                   .def(0.05)
                   .above(0),
+              choice("bed", {"free-slip", "no-slip"},
+                     "The tank's floor and walls: free-slip, or no-slip (the walls take the fluid's viscosity: "
+                     "solver.boundary_viscosity = solver.artificial_viscosity), since the bed's friction sets "
+                     "the experiments' front speed")
+                  .def("free-slip"),
               solver_schema_with({{"artificial_viscosity", 0.02}}),
           });
 }
@@ -68,6 +73,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double dx = a / res;
   const double L = double(prm["length_ratio"]) * a, Hc = double(prm["height_ratio"]) * a;
   const double depth = int(prm["depth_particles"]) * dx;
+  Json solver_settings = prm["solver"];
+  if (prm["bed"] == "no-slip") solver_settings["boundary_viscosity"] = solver_settings["artificial_viscosity"];
   const Json doc = tank_scene_json({"validation/dam-break",
                                     {L, depth, 1.25 * Hc},
                                     {a, depth, Hc},
@@ -75,7 +82,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
                                     g,
                                     rho0,
                                     prm["viscosity"],
-                                    prm["solver"]});
+                                    solver_settings});
   const Scene scene = scene_from_json(doc);
 
   const double shift_lo = prm["shift_min"], shift_hi = prm["shift_max"];
