@@ -49,6 +49,23 @@
 #define COL_AV 3
 #define COL_ERR 4
 
+/* The reorder's structure-of-arrays copy: positions and masses, blocks of `stride` floats. */
+#define DFSPH_SOA(soa, stride)                  \
+  global const float* X = (soa);                \
+  global const float* Y = (soa) + (stride);     \
+  global const float* Z = (soa) + 2 * (stride); \
+  global const float* M = (soa) + 3 * (stride);
+
+/* Inside FOR_EACH_NEIGHBOUR_ROW's loop over candidates j..: the lanes' offsets x_ij (dx, dy, dz), r²
+ * and which lanes are real neighbours (`in`), from the soa positions X, Y, Z; the three passes below
+ * share it. */
+#define DFSPH_LANES(pi, j, je, H2)                                      \
+  const floatV dx = (pi).x - vloadV(0, X + (j));                        \
+  const floatV dy = (pi).y - vloadV(0, Y + (j));                        \
+  const floatV dz = (pi).z - vloadV(0, Z + (j));                        \
+  const floatV r2 = dx * dx + dy * dy + dz * dz;                        \
+  const intV in = (THAW_LANE_IDS < (int)((je) - (j))) & (r2 < (H2));
+
 /* FM: who is fluid, as the lanes of the other passes read it. */
 kernel void dfsph_columns(global const float4* pos, global const uchar* phase, global float* col, const uint stride,
                           const uint n) {
@@ -73,20 +90,13 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
-  global const float* M = soa + 3 * stride;
+  DFSPH_SOA(soa, stride)
   global const float* FM = col + COL_FM * stride;
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
   floatV count = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pi.x - vloadV(0, X + j);
-      const floatV dy = pi.y - vloadV(0, Y + j);
-      const floatV dz = pi.z - vloadV(0, Z + j);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      DFSPH_LANES(pi, j, je, H2)
       const floatV gf = grad_shape(sqrt(r2) * inv_H); /* ∇W = sigma/H² gf x_ij; the factor comes last */
       const floatV mg = vloadV(0, M + j) * gf;
       gx += select((floatV)(0.0f), mg * dx, in);
@@ -112,21 +122,14 @@ float density_rate(const float4 pi, const float3 vi, global const float* soa, gl
                    const Grid g, const float H, const uint stride) {
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
-  global const float* M = soa + 3 * stride;
+  DFSPH_SOA(soa, stride)
   global const float* VX = soa + 4 * stride;
   global const float* VY = soa + 5 * stride;
   global const float* VZ = soa + 6 * stride;
   floatV acc = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pi.x - vloadV(0, X + j);
-      const floatV dy = pi.y - vloadV(0, Y + j);
-      const floatV dz = pi.z - vloadV(0, Z + j);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      DFSPH_LANES(pi, j, je, H2)
       const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
                         (vi.z - vloadV(0, VZ + j)) * dz;
       const floatV t = vloadV(0, M + j) * grad_shape(sqrt(r2) * inv_H) * vd;
@@ -195,20 +198,13 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
-  global const float* M = soa + 3 * stride;
+  DFSPH_SOA(soa, stride)
   global const float* KR = col + COL_KR * stride;
   const float kri = KR[i];
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pi.x - vloadV(0, X + j);
-      const floatV dy = pi.y - vloadV(0, Y + j);
-      const floatV dz = pi.z - vloadV(0, Z + j);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      DFSPH_LANES(pi, j, je, H2)
       const floatV t = vloadV(0, M + j) * (kri + vloadV(0, KR + j)) * grad_shape(sqrt(r2) * inv_H);
       ax += select((floatV)(0.0f), t * dx, in);
       ay += select((floatV)(0.0f), t * dy, in);
