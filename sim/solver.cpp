@@ -616,7 +616,6 @@ void Solver::step_dfsph() {
     dfsph_->density_solve(neighbours(), dt);
     dfsph_->write_pressure(fluid_->state(), dt);
   });
-
   // Ice takes the reaction of the solves' pressure impulses and the forces pass's viscosity (rigid.cl).
   if (rigid_) timed(Stage::IceForces, [&] { rigid_->compute_forces(buffers()); });
   if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
