@@ -36,6 +36,9 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
     s.dryers.push_back({d.position.cast<float>(), d.direction.normalized().cast<float>(),
                         static_cast<float>(0.5 * d.nozzle_diameter), static_cast<float>(d.half_angle),
                         static_cast<float>(d.reach), d.on});
+  for (const Emitter& e : scene.emitters)
+    s.dryers.push_back({e.position.cast<float>(), e.direction.normalized().cast<float>(),
+                        static_cast<float>(e.radius), 0.0f, 0.0f, false});
   for (const Lamp& l : scene.lamps) {
     // The rectangle's width runs horizontally (across the normal and z) where it can, as the photon
     // tracer lays it out (sim/heat_stage.cpp).

@@ -15,8 +15,10 @@
 #include "render/egl_context.h"
 #include "render/image_io.h"
 #include "render/picking.h"
+#include "render/snapshot.h"
 #include "render/surface_renderer.h"
 #include "sim/error.h"
+#include "sim/scene.h"
 #include "tests/render/lattice_snapshot.h"
 #include "tests/test_support.h"
 
@@ -495,6 +497,34 @@ TEST_F(RenderTest, IceUnderWaterShowsThroughIt) {
     EXPECT_GT(under_water, sphere_pixels / 2);
   }
   renderer().set_quality(SurfaceRenderer::Quality::Full);
+}
+
+// A tap (an emitter) is drawn as a dryer's nozzle that never blows: the snapshot carries it after the
+// dryers, with the nozzle's radius and direction, and it changes the pixels where it is, closed or open.
+TEST_F(RenderTest, ATapIsDrawnAsItsNozzle) {
+  const Scene scene = load_scene("pour-into-glass");
+  ASSERT_EQ(scene.emitters.size(), 1u);
+  const Emitter& e = scene.emitters[0];
+  const RenderSnapshot s = make_snapshot(HostParticles{}, {}, scene, 0.0, 0);
+  ASSERT_EQ(s.dryers.size(), scene.dryers.size() + 1);
+  const DryerMarker& tap = s.dryers.back();
+  EXPECT_EQ(tap.position, e.position.cast<float>());
+  EXPECT_NEAR((tap.direction - e.direction.normalized().cast<float>()).norm(), 0.0f, 1e-6f);
+  EXPECT_FLOAT_EQ(tap.nozzle_radius, static_cast<float>(e.radius));
+  EXPECT_FALSE(tap.on) << "a tap has no cone";
+  const OrbitCamera camera = centred_camera(0.7, 160, 120);
+  const DensityFields f = sphere_fields(&DensityFields::ice, 0.05f, 48);
+  DryerMarker drawn = tap;
+  drawn.position = Vector3f(0.0f, 0.0f, 0.12f);
+  drawn.nozzle_radius = 0.015f;
+  renderer().set_sources({}, {});
+  const Image none = renderer().render(f, camera);
+  renderer().set_sources({drawn}, {});
+  const Image with_tap = renderer().render(f, camera);
+  renderer().set_sources({}, {});
+  const long pixels = changed_pixels(none, with_tap, 6);
+  std::printf("[ info ] the tap's nozzle changes %ld pixels\n", pixels);
+  EXPECT_GT(pixels, 30);
 }
 
 // A dryer is drawn where it is and where it points: its nozzle changes pixels against no dryer; blowing,
