@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "sim/cl_launch.h"
+#include "sim/solver.h"
 
 namespace thaw {
 
@@ -14,8 +15,8 @@ constexpr int kColumns = 5;  // FM, KR, AD, AV, ERR (sim/kernels/dfsph.cl)
 }
 
 DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-                       double support, double spacing, const std::string& build_options,
-                       const ParticleLayout& layout, const cl::Buffer& flow)
+                       const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
+                       const cl::Buffer& flow)
     : cl_(cl), store_(store), f_(core), layout_(layout), flow_(flow) {
   // The accumulated (sum kappa dt^2, sum kappa dt) of the step's two solves: the next step's warm start,
   // saved so that a resumed run continues bitwise.
@@ -34,16 +35,12 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   k_predict_ = cl::Kernel(program, "dfsph_predict");
   k_drift_ = cl::Kernel(program, "dfsph_drift");
   k_pressure_ = cl::Kernel(program, "dfsph_pressure");
-  support_ = static_cast<float>(support);
+  support_ = k.support;
   // A full neighbourhood holds about (4/3) pi (H / dx)^3 particles; below 60 % of it a particle is at a
   // surface, where the divergence solve leaves it (20 of 33 at H = 2 dx, SPlisHSPlasH's threshold).
-  const double full = 4.0 / 3.0 * M_PI * std::pow(support / spacing, 3);
+  const double full = 4.0 / 3.0 * M_PI * std::pow(double(k.support) / scene.spacing, 3);
   min_neighbours_ = static_cast<cl_uint>(std::lround(0.6 * full));
-  for (const Material& m : scene.materials)
-    if (m.kind == MaterialKind::Fluid) {
-      rest_density_ = m.density;
-      break;
-    }
+  rest_density_ = k.rest_density;
   density_tolerance_ = scene.solver.density_tolerance;
   divergence_tolerance_ = scene.solver.divergence_tolerance;
   max_iterations_ = scene.solver.max_pressure_iterations;

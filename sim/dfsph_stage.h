@@ -18,6 +18,8 @@
 
 namespace thaw {
 
+struct SolverConstants;
+
 // One solve of one step: iterations done, the mean error when it stopped (density: mean (rho* - rho0) /
 // rho0; divergence: mean (D rho / Dt) dt / rho0) and whether that met the tolerance.
 struct PressureSolve {
@@ -35,9 +37,9 @@ struct PressureSolveTotals {
 
 class DfsphStage {
  public:
-  // `flow` is the fluid stage's material table (rest densities); `density` the fluid stage's field.
-  DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene, double support,
-             double spacing, const std::string& build_options, const ParticleLayout& layout,
+  // `flow` is the fluid stage's material table (each particle's rest density).
+  DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
+             const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
              const cl::Buffer& flow);
 
   // After the density pass: who is fluid, and alpha for both solves.

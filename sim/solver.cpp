@@ -299,8 +299,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   grid_ = std::make_unique<NeighbourGrid>(cl_, scene_, k_.support, kGridReach, opts, layout_, lo, hi);
   if (scene_.solver.flow) fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_);
   if (fluid_ && scene_.solver.pressure == PressureSolver::Dfsph)
-    dfsph_ = std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_.support, scene_.spacing, opts, layout_,
-                                          fluid_->flow());
+    dfsph_ = std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow());
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
   if (plan.build)
     heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
@@ -494,7 +493,9 @@ double Solver::choose_time_step() {
     os << "step " << steps_ + 1 << " (t = " << time_ << " s): ";
     return os.str();
   };
-  const char* advice = "; lower solver.max_dt or solver.cfl, or raise solver.sound_speed_factor";
+  // DFSPH has no sound speed: its step follows the flow.
+  const char* advice = dfsph_ ? "; lower solver.max_dt or solver.cfl, or tighten solver.density_tolerance"
+                              : "; lower solver.max_dt or solver.cfl, or raise solver.sound_speed_factor";
   if (bad != 0xffffffffu) {
     const bool accel_only = (bad & 0x80000000u) != 0;
     throw BlowUpError(

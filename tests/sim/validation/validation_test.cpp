@@ -103,10 +103,12 @@ TEST_F(Validation, DamBreakFrontFollowsMartinMoyceAfterTheGatesOpeningTime) {
   const CaseResult narrow = run_validation(cl(), "dam-break", 20, {"solver.pressure=dfsph", "shift_max=0.1"});
   EXPECT_FALSE(narrow.passed());
   EXPECT_FALSE(narrow.metrics.front().second.passed()) << narrow.metrics.front().second.value;
-  // A no-slip bed (the walls take the fluid's viscosity) holds the front back: slower over the window.
+  // A no-slip bed (the walls take the fluid's viscosity) holds the front back: slower over the window
+  // than the free-slip run above (the narrow window changes the gates, not the run).
+  const double free_slip_speed = narrow.metrics.back().second.value;
   const CaseResult bed = run_validation(cl(), "dam-break", 20, {"solver.pressure=dfsph", "bed=no-slip"});
   print(bed);
-  EXPECT_LT(bed.metrics.back().second.value, 0.95 * narrow.metrics.back().second.value);
+  EXPECT_LT(bed.metrics.back().second.value, 0.95 * free_slip_speed);
 }
 
 TEST_F(Validation, ConductionPassesOnOrderedAndJitteredParticles) {
