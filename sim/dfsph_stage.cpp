@@ -35,7 +35,10 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   k_predict_ = cl::Kernel(program, "dfsph_predict");
   k_drift_ = cl::Kernel(program, "dfsph_drift");
   k_pressure_ = cl::Kernel(program, "dfsph_pressure");
+  k_extrapolate_ = cl::Kernel(program, "dfsph_extrapolate");
   support_ = k.support;
+  gravity_ = {{static_cast<float>(scene.gravity.x()), static_cast<float>(scene.gravity.y()),
+               static_cast<float>(scene.gravity.z()), 0.0f}};
   // A full neighbourhood holds about (4/3) pi (H / dx)^3 particles; below 60 % of it a particle is at a
   // surface, where the divergence solve leaves it (20 of 33 at H = 2 dx, SPlisHSPlasH's threshold).
   const double full = 4.0 / 3.0 * M_PI * std::pow(double(k.support) / scene.spacing, 3);
@@ -85,6 +88,15 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
   // Warm start: apply last step's accumulated kappa, which stays in the accumulator.
   set_args(k_warm_, store_[f_.density], store_[f_.phase], col_, store_[kappa_], fdt, mode, layout_.stride, n);
   launch(q, k_warm_, layout_.n);
+  // The boundary's pressure from the warm-started fluid, with gravity's share in the density solve; then
+  // after every sweep's error pass, from the fluid's increments alone.
+  auto extrapolate = [&](bool hydrostatic) {
+    set_args(k_extrapolate_, store_[f_.position], nv.soa, store_[f_.density], store_[f_.phase], col_,
+             nv.cell_start, nv.grid, support_, gravity_, cl_int(hydrostatic ? 1 : 0), layout_.stride, n);
+  };
+  extrapolate(density_mode);
+  launch(q, k_extrapolate_, layout_.n);
+  extrapolate(false);
   set_args(k_correct_, store_[f_.velocity], nv.soa, store_[f_.phase], col_, store_[f_.position],
            store_[f_.density], store_[kappa_], nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride, n);
   launch(q, k_correct_, layout_.n);
@@ -96,6 +108,7 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
   const double tolerance = density_mode ? density_tolerance_ : divergence_tolerance_;
   for (;;) {
     launch(q, k_error_, layout_.n);
+    launch(q, k_extrapolate_, layout_.n);
     out.error = mean_error(rest_density_) * scale;
     // At least two corrections each (Bender & Koschier 2017, Algorithms 2 and 3), then until the
     // tolerance. One for the divergence saved 12 % of the step in the dam break but slowed its front (dZ/dT*

@@ -32,6 +32,22 @@ TEST_F(Validation, HydrostaticPassesAtCiResolution) {
   for (const auto& [key, m] : r.metrics) EXPECT_LE(m.error, m.gate) << key;
 }
 
+// Issue 17's hydrostatic gate for DFSPH: the same tank and reference, the profile within 1 % of rho0 g H
+// and the mean speed below 1e-3 sqrt(gH), the step far longer than WCSPH's (DfsphTest checks the ratio).
+// DFSPH's pressure is a per-step impulse that swings from step to step with the Jacobi iterations it took,
+// so every step of a longer window is sampled (at the WCSPH setting, 1 step in 5 over 0.1 s, the case
+// measured 0.14 % and 0.95e-3: a thin margin on the speed). Tolerance 0.05 % as SPlisHSPlasH's default;
+// at the default 0.1 % the case measured 0.33 % and 0.94e-3 (docs/VALIDATION-RESULTS.md).
+TEST_F(Validation, HydrostaticWithDfsphPassesAtCiResolution) {
+  const CaseResult r =
+      run_validation(cl(), "hydrostatic", 20,
+                     {"solver.pressure=dfsph", "solver.density_tolerance=0.0005", "solver.divergence_tolerance=0.0005",
+                      "sample_every=1", "free_time=0.5"});
+  print(r);
+  EXPECT_TRUE(r.passed());
+  for (const auto& [key, m] : r.metrics) EXPECT_LE(m.error, m.gate) << key;
+}
+
 // The reference is computed from the parameters: its bottom pressure is the column's weight per area
 // whatever the gravity, density or stiffness, and it tends to rho0 g (H - z) as the fluid stiffens.
 TEST(HydrostaticReference, WeighsTheColumnAndTendsToTheIncompressibleProfile) {
