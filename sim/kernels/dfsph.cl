@@ -88,12 +88,26 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
                         const float H, const uint min_neighbours, const uint stride, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
-  const int boundary = THAW_IS_STATIC(phase[i]);
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
   DFSPH_SOA(soa, stride)
   global const float* FM = col + COL_FM * stride;
+  col[COL_ERR * stride + i] = 0.0f;
+  if (THAW_IS_STATIC(phase[i])) {
+    /* A boundary particle only needs to know whether fluid is within reach (the extrapolation takes a
+     * pressure from it): the fluid masses within the support, without the kernel. */
+    floatV fluid = (floatV)(0.0f);
+    FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+      for (uint j = jb; j < je; j += THAW_VW) {
+        DFSPH_LANES(pi, j, je, H2)
+        fluid += select((floatV)(0.0f), vloadV(0, FM + j), in);
+      }
+    })
+    col[COL_AD * stride + i] = lanes_sum(fluid) > 0.0f ? 1.0f : 0.0f;
+    col[COL_AV * stride + i] = 0.0f;
+    return;
+  }
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
   floatV count = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
@@ -111,12 +125,6 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
   const float scale = THAW_SIGMA(H) * inv_H * inv_H;
   const float3 G = scale * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
   const float S = pi.w * scale * scale * lanes_sum(s);
-  col[COL_ERR * stride + i] = 0.0f;
-  if (boundary) { /* whether the extrapolation has fluid to take a pressure from */
-    col[COL_AD * stride + i] = S > 0.0f ? 1.0f : 0.0f;
-    col[COL_AV * stride + i] = 0.0f;
-    return;
-  }
   const float d = dot(G, G) + S;
   /* A particle without neighbours (d = 0) cannot be corrected by its own pressure: leave it alone. */
   const float alpha = d > 0.0f ? density[i] / d : 0.0f;
