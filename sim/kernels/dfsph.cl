@@ -27,7 +27,10 @@
  *   FM    m_j for fluid particles, 0 for boundary ones
  *   KR    κ_j / ρ_j of the current iteration (boundary particles: extrapolated, dfsph_extrapolate)
  *   AD    α_j for the density solve, AV α_j for the divergence solve (0 where it is not solved); for a
- *         boundary particle AD is 1 when fluid is within its support (it is extrapolated to), else 0
+ *         boundary particle AD is -1 when fluid is within its support (it is extrapolated to), else 0.
+ *         Negative, so that ice melting between alpha and the density solve (the heat stage runs
+ *         between them) is solved with α 0 that step: read as α 1 it took κ 10⁷ times too large and
+ *         blew up the first meltwater of ice-on-plate
  *   ERR   this iteration's error: ρ* - ρ0 or Dρ/Dt (≥ 0; 0 for boundary particles)
  * and the saved field `kappa` (sim/dfsph_stage.cpp): the step's accumulated (Σ κ dt², Σ κ dt) of the two
  * solves, dt-free, which warm-start the next step (2017 §4.3) and make a resumed run bitwise the same. */
@@ -104,7 +107,7 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
         fluid += select((floatV)(0.0f), vloadV(0, FM + j), in);
       }
     })
-    col[COL_AD * stride + i] = lanes_sum(fluid) > 0.0f ? 1.0f : 0.0f;
+    col[COL_AD * stride + i] = lanes_sum(fluid) > 0.0f ? -1.0f : 0.0f;
     col[COL_AV * stride + i] = 0.0f;
     return;
   }
@@ -172,7 +175,7 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
   if (density_mode) {
     const float rho0 = flow[material[i]].rest_density;
     err = fmax(rho + dt * rate - rho0, 0.0f);
-    k = err * col[COL_AD * stride + i] / (dt * dt);
+    k = err * fmax(col[COL_AD * stride + i], 0.0f) / (dt * dt); /* a boundary's flag, if it melted: 0 */
   } else {
     const float a = col[COL_AV * stride + i];
     err = a > 0.0f ? fmax(rate, 0.0f) : 0.0f;
@@ -196,7 +199,7 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
                               const uint stride, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
-  if (!THAW_IS_STATIC(phase[i]) || col[COL_AD * stride + i] == 0.0f) return;
+  if (!THAW_IS_STATIC(phase[i]) || col[COL_AD * stride + i] >= 0.0f) return; /* flagged -1 by dfsph_alpha */
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
