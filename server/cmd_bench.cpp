@@ -39,6 +39,13 @@ int cmd_bench(int argc, char** argv) {
   const std::string kind = argv[2];
   if (kind == "throughput") {
     CliArgs args(argc, argv, 3, {"--sizes", "--steps", "--device"}, {"--json"});
+    // Its scene is its own (a dam break sized by --sizes, WCSPH against hand-written loops): a --set would
+    // be silently ignored, so it is refused. DFSPH against WCSPH is measured with `thaw run` on the same
+    // scene (docs/BENCHMARKS.md).
+    if (!args.sets().empty())
+      throw Error("bench throughput takes no --set ('" + args.sets().front() +
+                  "'): it times its own dam-break scene against reference loops; to compare solvers, time "
+                  "`thaw run dam-break --set solver.pressure=dfsph` against wcsph");
     ThroughputOptions o;
     if (auto s = args.value("--sizes")) o.sizes = list_of<std::size_t>(*s, "--sizes");
     o.steps = static_cast<int>(args.integer("--steps", o.steps));

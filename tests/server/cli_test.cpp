@@ -143,6 +143,16 @@ TEST(ThawCli, BenchThroughputPrintsARowPerSize) {
   }
 }
 
+// The throughput bench times its own scene: a --set it would ignore is refused, naming it.
+TEST(ThawCli, BenchThroughputRefusesASetItWouldIgnore) {
+  TempDir dir("cli-bench-throughput-set");
+  const auto r = run_thaw("bench throughput --sizes 2000 --steps 1 --set solver.pressure=dfsph", dir);
+  ASSERT_TRUE(r.exited) << describe(r);
+  EXPECT_NE(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("solver.pressure=dfsph"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("thaw run dam-break"), std::string::npos) << describe(r);
+}
+
 TEST(ThawCli, BenchAccuracyWritesItsTableAndPlot) {
   TempDir dir("cli-bench-accuracy");
   const auto r = run_thaw(
