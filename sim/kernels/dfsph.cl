@@ -252,6 +252,16 @@ kernel void dfsph_warm(global const float* density, global const uchar* phase, g
 /* The second half: v_i -= dt Σ_j m_j (KR_i + KR_j) ∇W_ij, written to vel and to the soa copy the lanes
  * read. Boundary neighbours enter with their extrapolated KR and their Ψ. The κ applied is added to the
  * accumulator: κ dt² (density_mode) or κ dt. */
+/* Adds the κ a sweep applied to particle i's accumulator: κ dt² (density_mode) or κ dt. */
+void book_kappa(global float2* kappa, const uint i, const float k, const float dt, const int density_mode) {
+  float2 acc = kappa[i];
+  if (density_mode)
+    acc.x += k * dt * dt;
+  else
+    acc.y += k * dt;
+  kappa[i] = acc;
+}
+
 kernel void dfsph_correct(global float4* vel, global float* soa, global const uchar* phase, global const float* col,
                           global const float4* pos, global const float* density, global float2* kappa,
                           global const uint* cell_start, const Grid g, const float H, const float dt,
@@ -263,13 +273,7 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
   if (THAW_IS_STATIC(phase[i])) {
     /* A boundary particle does not move: it books the κ its fluid neighbours applied with it (their
      * pressure force from it; rigid ice takes the reaction through dfsph_pressure's state). */
-    float2 acc = kappa[i];
-    const float applied = kri * density[i] * (density_mode ? dt * dt : dt);
-    if (density_mode)
-      acc.x += applied;
-    else
-      acc.y += applied;
-    kappa[i] = acc;
+    book_kappa(kappa, i, kri * density[i], dt, density_mode);
     return;
   }
   const float4 pi = pos[i];
@@ -292,13 +296,7 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
   soa[4 * stride + i] = v.x;
   soa[5 * stride + i] = v.y;
   soa[6 * stride + i] = v.z;
-  float2 acc = kappa[i];
-  const float applied = kri * density[i] * (density_mode ? dt * dt : dt);
-  if (density_mode)
-    acc.x += applied;
-  else
-    acc.y += applied;
-  kappa[i] = acc;
+  book_kappa(kappa, i, kri * density[i], dt, density_mode);
 }
 
 /* Per tile: the sum of the errors over fluid particles, and their count (deterministic, unlike atomics). */
