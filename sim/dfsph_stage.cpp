@@ -45,6 +45,7 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   min_neighbours_ = static_cast<cl_uint>(std::lround(0.6 * full));
   rest_density_ = k.rest_density;
   density_tolerance_ = scene.solver.density_tolerance;
+  extrapolate_ = scene.solver.boundary_pressure == DfsphBoundary::Adami2012;
   divergence_tolerance_ = scene.solver.divergence_tolerance;
   max_iterations_ = scene.solver.max_pressure_iterations;
   col_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::size_t(layout.stride) * kColumns * 4);
@@ -95,7 +96,7 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
              nv.cell_start, nv.grid, support_, gravity_, cl_int(hydrostatic ? 1 : 0), layout_.stride, n);
   };
   extrapolate(density_mode);
-  launch(q, k_extrapolate_, layout_.n);
+  if (extrapolate_) launch(q, k_extrapolate_, layout_.n);
   extrapolate(false);
   set_args(k_correct_, store_[f_.velocity], nv.soa, store_[f_.phase], col_, store_[f_.position],
            store_[f_.density], store_[kappa_], nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride, n);
@@ -108,7 +109,7 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
   const double tolerance = density_mode ? density_tolerance_ : divergence_tolerance_;
   for (;;) {
     launch(q, k_error_, layout_.n);
-    launch(q, k_extrapolate_, layout_.n);
+    if (extrapolate_) launch(q, k_extrapolate_, layout_.n);
     out.error = mean_error(rest_density_) * scale;
     // At least two corrections each (Bender & Koschier 2017, Algorithms 2 and 3), then until the
     // tolerance. One for the divergence saved 12 % of the step in the dam break but slowed its front (dZ/dT*

@@ -78,6 +78,7 @@ class DfsphStage {
   int max_iterations_ = 100;
   cl::Kernel k_columns_, k_alpha_, k_error_, k_warm_, k_correct_, k_sum_, k_predict_, k_drift_, k_pressure_, k_extrapolate_;
   cl_float4 gravity_{};
+  bool extrapolate_ = true;  // solver.boundary_pressure adami2012; akinci2012 leaves the boundary's kappa 0
   cl::Buffer col_, sums_;
   PressureSolve last_density_, last_divergence_;
   PressureSolveTotals totals_;

@@ -42,6 +42,7 @@ const char* name(Eos e) { return e == Eos::Tait ? "tait" : "linear"; }
 const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph" : "wcsph"; }
 const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
 const char* name(ExposedArea) { return "iwasaki2010"; }
+const char* name(DfsphBoundary b) { return b == DfsphBoundary::Akinci2012 ? "akinci2012" : "adami2012"; }
 
 namespace {
 // A choice the schema has already checked, as its enum.
@@ -723,6 +724,8 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.divergence_tolerance = j["divergence_tolerance"].get<double>();
   s.max_pressure_iterations = j["max_pressure_iterations"].get<int>();
   s.pressure_relaxation = j["pressure_relaxation"].get<double>();
+  s.boundary_pressure =
+      choice_of<DfsphBoundary>(j["boundary_pressure"], {DfsphBoundary::Adami2012, DfsphBoundary::Akinci2012});
   s.eos = choice_of<Eos>(j["eos"], {Eos::Tait, Eos::Linear});
   s.gamma = j["gamma"].get<double>();
   s.speed_of_sound = j["speed_of_sound"].get<double>();

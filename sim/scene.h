@@ -32,6 +32,8 @@ enum class Eos { Tait, Linear };
 // Koschier 2015, 2017: sim/dfsph_stage.h).
 enum class PressureSolver { Wcsph, Dfsph };
 enum class BoundaryVolume { Lattice, Akinci2012 };
+// DFSPH: the pressure boundary particles take in the solves (sim/kernels/dfsph.cl).
+enum class DfsphBoundary { Adami2012, Akinci2012 };
 enum class ExposedArea { Iwasaki2010 };
 const char* name(MaterialKind k);    // "fluid", "solid", "ice"
 const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
@@ -39,6 +41,7 @@ const char* name(Eos e);             // "tait", "linear"
 const char* name(PressureSolver p);  // "wcsph", "dfsph"
 const char* name(BoundaryVolume b);  // "lattice", "akinci"
 const char* name(ExposedArea a);     // "iwasaki2010" (also the heat pass's function suffix)
+const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
 
 struct Material {
   std::string name;
@@ -141,6 +144,7 @@ struct SolverSettings {
   double divergence_tolerance = 0.001;  // dfsph: mean (D rho / Dt) dt / rho0 the divergence solve stops at
   int max_pressure_iterations = 100;    // dfsph: per solve and step
   double pressure_relaxation = 0.5;     // dfsph: the relaxed Jacobi's omega (sim/kernels/dfsph.cl)
+  DfsphBoundary boundary_pressure = DfsphBoundary::Adami2012;  // dfsph: extrapolated, or none (one-sided)
   Eos eos = Eos::Tait;
   double gamma = 7.0;                  // Tait exponent
   double speed_of_sound = 0.0;         // [m/s]; 0 = sound_speed_factor * reference_speed
