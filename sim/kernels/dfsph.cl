@@ -9,10 +9,11 @@
  * Adami et al. 2012 eq 27), so a pair with a wall carries the full load, as two fluid particles would.
  * The 2017 paper's one-sided coupling (κ_b = 0) carries half of it: water sank 0.37 spacings into the
  * floor and walls of the floating case (against 0.14 with WCSPH, whose walls have their own pressure),
- * which put the water's mass level 0.7 spacings above its surface (WCSPH: 0.4), and the hydrostatic tank's mean speed
- * stayed at 1.7e-3 sqrt(gH). With the extrapolation: the water's first layer 0.498 spacings above the
- * floor, the level by mass and by surface within 0.15-0.35 spacings, the tank at 0.85e-3. The one-sided
- * coupling stays selectable for comparison (solver.boundary_pressure akinci2012: no extrapolation). With ∇W_ij = gf(r) x_ij and
+ * which put the water's mass level 0.7 spacings above its surface (WCSPH: 0.4), and the hydrostatic
+ * tank's mean speed stayed at 1.7e-3 sqrt(gH). With the extrapolation: the water's first layer 0.498
+ * spacings above the floor, the level by mass and by surface within 0.15-0.35 spacings, the tank at
+ * 0.85e-3. The one-sided coupling stays selectable for comparison (solver.boundary_pressure akinci2012:
+ * no extrapolation). With ∇W_ij = gf(r) x_ij and
  *   G_i = Σ_j m_j ∇W_ij (fluid and boundary),  S_i = m_i Σ_{j fluid} m_j |∇W_ij|²,
  * a change κ_i of one particle alone changes its density by -dt² κ_i/ρ_i (|G_i|² + S_i), hence
  *   α_i = ρ_i / (|G_i|² + S_i)                                           (2015 eq 10, mixed masses)
