@@ -76,7 +76,8 @@ class DfsphStage {
   double rest_density_ = 1000;
   double density_tolerance_ = 0, divergence_tolerance_ = 0;
   int max_iterations_ = 100;
-  cl::Kernel k_columns_, k_alpha_, k_error_, k_warm_, k_correct_, k_sum_, k_predict_, k_drift_, k_pressure_, k_extrapolate_;
+  cl::Kernel k_columns_, k_alpha_, k_error_, k_warm_, k_correct_, k_sum_, k_predict_, k_drift_, k_pressure_,
+      k_extrapolate_;
   cl_float4 gravity_{};
   bool extrapolate_ = true;  // solver.boundary_pressure adami2012; akinci2012 leaves the boundary's kappa 0
   cl::Buffer col_, sums_;

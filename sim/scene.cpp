@@ -509,9 +509,10 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   if (s.solver.pressure == PressureSolver::Dfsph)
     for (std::size_t b = 0; b < s.ice.size(); ++b)
       if (s.ice[b].motion == IceBlock::Motion::Free)
-        throw SceneError("solver.pressure", "dfsph does not float free ice yet (ice[" + std::to_string(b) +
-                                                "] has motion free; in the floating case it floats 2-6 % high): "
-                                                "use wcsph for scenes with free ice, or make the ice fixed");
+        throw SceneError("solver.pressure",
+                         "dfsph does not float free ice yet (ice[" + std::to_string(b) +
+                             "] has motion free; in the floating case it floats 2-6 % high): "
+                             "use wcsph for scenes with free ice, or make the ice fixed");
   if (s.solver.min_dt >= s.solver.max_dt) {
     throw SceneError("solver.min_dt", format_number(s.solver.min_dt) + " s must be below solver.max_dt (" +
                                           format_number(s.solver.max_dt) + " s)");

@@ -42,11 +42,12 @@ const Field& solver_schema() {
               .def(0.5)
               .above(0)
               .at_most(1),
-          choice("boundary_pressure", {"adami2012", "akinci2012"},
-                 "dfsph: the pressure of wall, solid and ice particles in the solves: adami2012 = extrapolated "
-                 "from the fluid next to them each sweep (Adami et al. 2012), so a wall carries the full load; "
-                 "akinci2012 = none, the fluid's own pressure one-sided (Akinci et al. 2012, as Bender & "
-                 "Koschier 2017 use it), which carries half and lets water sink into walls (for comparison)")
+          choice(
+              "boundary_pressure", {"adami2012", "akinci2012"},
+              "dfsph: the pressure of wall, solid and ice particles in the solves: adami2012 = extrapolated "
+              "from the fluid next to them each sweep (Adami et al. 2012), so a wall carries the full load; "
+              "akinci2012 = none, the fluid's own pressure one-sided (Akinci et al. 2012, as Bender & "
+              "Koschier 2017 use it), which carries half and lets water sink into walls (for comparison)")
               .def("adami2012"),
           choice("eos", {"tait", "linear"}, "Equation of state: Tait (stiff) or linear in density")
               .def("tait"),

@@ -213,9 +213,10 @@ TEST_F(DfsphTest, MeltwaterJoinsTheSolveWithoutABlowUp) {
   const double mass0 = measure(d).ice_mass + measure(d).water_mass;
   while (d.time() < 1.0) d.step();
   const Metrics m = measure(d);
-  std::printf("[ info ] at %.3g s: water %.4g kg of %.4g kg, energy closure %.3g J of %.4g J in; %zu steps\n", d.time(),
-              m.water_mass, mass0, m.closure(), m.budget.heat_in(), std::size_t(d.steps()));
-  EXPECT_GT(m.count[static_cast<int>(Phase::Water)], 0u) << "no meltwater: the case no longer tests its way in";
+  std::printf("[ info ] at %.3g s: water %.4g kg of %.4g kg, energy closure %.3g J of %.4g J in; %zu steps\n",
+              d.time(), m.water_mass, mass0, m.closure(), m.budget.heat_in(), std::size_t(d.steps()));
+  EXPECT_GT(m.count[static_cast<int>(Phase::Water)], 0u)
+      << "no meltwater: the case no longer tests its way in";
   // Per particle, an ice mass is its boundary mass times rho_ice / rho0 in float: 1.1e-9 relative apart
   // from the water's after 100 of 1000 particles melted. The bound is float rounding, not a loss.
   EXPECT_NEAR(m.ice_mass + m.water_mass, mass0, 1e-7 * mass0);
@@ -250,8 +251,9 @@ TEST_F(DfsphTest, WallsCarryTheFullLoadWithTheirExtrapolatedPressure) {
     return z[z.size() / 2];
   };
   const double adami = first_layer("adami2012"), akinci = first_layer("akinci2012");
-  std::printf("[ info ] the water's first layer above the floor: %.3f spacings (adami2012), %.3f (akinci2012)\n",
-              adami, akinci);
+  std::printf(
+      "[ info ] the water's first layer above the floor: %.3f spacings (adami2012), %.3f (akinci2012)\n",
+      adami, akinci);
   EXPECT_GT(adami, 0.4);
   EXPECT_LT(akinci, adami - 0.1);
 }
