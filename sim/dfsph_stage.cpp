@@ -89,15 +89,16 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
   // Warm start: apply last step's accumulated kappa, which stays in the accumulator.
   set_args(k_warm_, store_[f_.density], store_[f_.phase], col_, store_[kappa_], fdt, mode, layout_.stride, n);
   launch(q, k_warm_, layout_.n);
-  // The boundary's pressure from the warm-started fluid, with gravity's share in the density solve; then
-  // after every sweep's error pass, from the fluid's increments alone.
+  // The boundary's pressure (solver.boundary_pressure adami2012): from the warm-started fluid, with
+  // gravity's share in the density solve; then after every sweep's error pass, from the fluid's increments
+  // alone.
   auto extrapolate = [&](bool hydrostatic) {
+    if (!extrapolate_) return;
     set_args(k_extrapolate_, store_[f_.position], nv.soa, store_[f_.density], store_[f_.phase], col_,
              nv.cell_start, nv.grid, support_, gravity_, cl_int(hydrostatic ? 1 : 0), layout_.stride, n);
+    launch(q, k_extrapolate_, layout_.n);
   };
   extrapolate(density_mode);
-  if (extrapolate_) launch(q, k_extrapolate_, layout_.n);
-  extrapolate(false);
   set_args(k_correct_, store_[f_.velocity], nv.soa, store_[f_.phase], col_, store_[f_.position],
            store_[f_.density], store_[kappa_], nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride, n);
   launch(q, k_correct_, layout_.n);
@@ -109,7 +110,7 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
   const double tolerance = density_mode ? density_tolerance_ : divergence_tolerance_;
   for (;;) {
     launch(q, k_error_, layout_.n);
-    if (extrapolate_) launch(q, k_extrapolate_, layout_.n);
+    extrapolate(false);
     out.error = mean_error(rest_density_) * scale;
     // At least two corrections each (Bender & Koschier 2017, Algorithms 2 and 3), then until the
     // tolerance. One for the divergence saved 12 % of the step in the dam break but slowed its front (dZ/dT*
