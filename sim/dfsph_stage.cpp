@@ -24,6 +24,7 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   std::ostringstream relaxation;
   relaxation.precision(9);
   relaxation << build_options << " -DTHAW_OMEGA=" << scene.solver.pressure_relaxation << "f";
+  if (scene.solver.boundary_pressure == DfsphBoundary::Adami2012) relaxation << " -DTHAW_DFSPH_EXTRAPOLATE";
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph.cl"},
                                 relaxation.str());
   k_columns_ = cl::Kernel(program, "dfsph_columns");

@@ -100,6 +100,8 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
   global const float* FM = col + COL_FM * stride;
   col[COL_ERR * stride + i] = 0.0f;
   if (THAW_IS_STATIC(phase[i])) {
+    col[COL_AV * stride + i] = 0.0f;
+#ifdef THAW_DFSPH_EXTRAPOLATE
     /* A boundary particle only needs to know whether fluid is within reach (the extrapolation takes a
      * pressure from it): the fluid masses within the support, without the kernel. */
     floatV fluid = (floatV)(0.0f);
@@ -110,7 +112,9 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
       }
     })
     col[COL_AD * stride + i] = lanes_sum(fluid) > 0.0f ? -1.0f : 0.0f;
-    col[COL_AV * stride + i] = 0.0f;
+#else
+    col[COL_AD * stride + i] = 0.0f; /* one-sided (akinci2012): nothing is extrapolated, no visit needed */
+#endif
     return;
   }
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
