@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
@@ -113,6 +114,19 @@ DeviceInfo choose_device(const std::string& requested) {
       "' (--device / THAW_DEVICE; also accepted: gpu, cpu, P:D); devices present:" + describe_all(all));
 }
 
+std::size_t ClRuntime::layout_tiles() const {
+  if (const char* env = std::getenv("THAW_TILES")) {
+    char* end = nullptr;
+    const long v = std::strtol(env, &end, 10);
+    if (end == env || *end != '\0' || v < 1 || v > (1 << 24))
+      throw Error("THAW_TILES='" + std::string(env) +
+                  "': must be a whole number of tiles from 1 to 16777216");
+    return static_cast<std::size_t>(v);
+  }
+  if (info_.type == "GPU") return 32 * std::max(1u, info_.compute_units);
+  return 32;
+}
+
 ClRuntime::ClRuntime(const std::string& device_spec) : info_(choose_device(device_spec)) {
   device_ = device_at(info_);
   context_ = cl::Context(device_);
@@ -146,8 +160,9 @@ cl::Program ClRuntime::build_sources(const std::vector<Source>& sources, const s
     source += "\n";
     names += (names.empty() ? "" : ", ") + name;
   }
-  cl::Program program(context_, source);
   const std::string opts = "-cl-std=CL1.2 -cl-mad-enable " + options;
+  if (observer_) observer_(source, opts);
+  cl::Program program(context_, source);
   cl_int status = CL_SUCCESS;
   try {
     program.build({device_}, opts.c_str());
@@ -164,9 +179,48 @@ cl::Program ClRuntime::build_sources(const std::vector<Source>& sources, const s
       log = "(no build log)";
     }
     throw Error("OpenCL build of " + names + " failed on " + info_.name + " (" + cl_error_name(status) +
-                ", options '" + opts + "'):\n" + log);
+                ", options '" + opts + "'):\n" + annotate_build_log(log, sources));
+  }
+  // A vendor's compiler warnings (pocl prints none) are shown on request: THAW_CL_BUILD_LOG=1.
+  if (const char* env = std::getenv("THAW_CL_BUILD_LOG"); env && *env && std::string(env) != "0") {
+    const std::string log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
+    if (log.find_first_not_of(" \t\r\n") != std::string::npos)
+      std::fprintf(stderr, "OpenCL build log of %s on %s:\n%s\n", names.c_str(), info_.name.c_str(),
+                   annotate_build_log(log, sources).c_str());
   }
   return program;
+}
+
+std::string annotate_build_log(const std::string& log, const std::vector<ClRuntime::Source>& sources) {
+  // build_sources() puts "#line 1 \"name\"" before each file and a newline after it: file k's first
+  // line is line first[k] + 1 of the whole.
+  std::vector<std::pair<long, std::string>> first;  // (whole-source line of the #line directive, name)
+  long line = 1;
+  for (const auto& [name, text] : sources) {
+    first.emplace_back(line, name);
+    line += 1 + static_cast<long>(std::count(text.begin(), text.end(), '\n')) + 1;
+  }
+  static const std::string tag = "<kernel>:";
+  std::string out;
+  std::size_t at = 0;
+  for (std::size_t k; (k = log.find(tag, at)) != std::string::npos;) {
+    out.append(log, at, k - at);
+    std::size_t e = k + tag.size();
+    long whole = 0;
+    while (e < log.size() && std::isdigit(static_cast<unsigned char>(log[e])))
+      whole = whole * 10 + (log[e++] - '0');
+    auto it = std::upper_bound(first.begin(), first.end(), whole,
+                               [](long v, const std::pair<long, std::string>& f) { return v < f.first; });
+    if (e == k + tag.size() || it == first.begin()) {
+      out.append(log, k, e - k);  // no number, or before the first file: as it was
+    } else {
+      --it;
+      out += it->second + ":" + std::to_string(whole - it->first);
+    }
+    at = e;
+  }
+  out.append(log, at, std::string::npos);
+  return out;
 }
 
 const char* cl_error_name(cl_int code) {

@@ -1,6 +1,7 @@
 #pragma once
 // The OpenCL device, context and queue, and building programs from the embedded kernel files.
 #include <CL/opencl.hpp>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -39,7 +40,17 @@ class ClRuntime {
   using Source = std::pair<std::string, std::string_view>;
   cl::Program build_sources(const std::vector<Source>& sources, const std::string& options = "") const;
 
+  // Called with each program's whole source and options just before it is built: the tests pass every
+  // program a scene builds through a strict OpenCL C compiler (tests/sim/cl_runtime_test.cpp), since a
+  // vendor's compiler may refuse what pocl accepts.
+  using BuildObserver = std::function<void(const std::string& source, const std::string& options)>;
+  void set_build_observer(BuildObserver f) { observer_ = std::move(f); }
+
   const DeviceInfo& info() const { return info_; }
+
+  // How many tiles the particles are cut into for the per-tile passes (layout_for in sim/stage.h): 32
+  // on a CPU, 32 per compute unit on a GPU; $THAW_TILES overrides it (for `thaw bench`).
+  std::size_t layout_tiles() const;
   std::string description() const;
   cl::Context& context() { return context_; }
   cl::CommandQueue& queue() { return queue_; }
@@ -50,7 +61,13 @@ class ClRuntime {
   cl::Device device_;
   cl::Context context_;
   cl::CommandQueue queue_;
+  BuildObserver observer_;
 };
+
+// A build log with the compiler's positions in the concatenated source ("<kernel>:12:5:", as NVIDIA's
+// compiler writes them, which ignores #line) turned into the embedded file's own ("sim/kernels/grid.cl:
+// 3:5:"); `sources` are the (name, text) pairs in the order build_sources() joined them.
+std::string annotate_build_log(const std::string& log, const std::vector<ClRuntime::Source>& sources);
 
 // OpenCL error codes as names ("CL_OUT_OF_RESOURCES") for messages.
 const char* cl_error_name(cl_int code);

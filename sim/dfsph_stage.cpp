@@ -67,9 +67,10 @@ void DfsphStage::prepare(const NeighbourView& nv) {
 
 double DfsphStage::mean_error(double rest_density) {
   auto& q = cl_.queue();
-  const cl_uint tiles = std::max<cl_uint>(layout_.ntiles, 1);
+  const cl_uint tiles = layout_.ntiles;
+  if (tiles == 0) return 0.0;
   set_args(k_sum_, col_, store_[f_.phase], sums_, layout_.stride, static_cast<cl_uint>(layout_.n), layout_.tile);
-  q.enqueueNDRangeKernel(k_sum_, cl::NullRange, cl::NDRange(tiles));
+  launch(q, k_sum_, tiles);
   std::vector<cl_float2> s(tiles);
   q.enqueueReadBuffer(sums_, CL_TRUE, 0, tiles * 8, s.data());
   double sum = 0, count = 0;

@@ -124,7 +124,7 @@ FlowLimits FluidStage::limits() {
   auto& q = cl_.queue();
   set_args(k_limits_, store_[f_.position], store_[f_.velocity], accel_, store_[f_.phase], limits_f_,
            limits_i_, static_cast<cl_uint>(layout_.n), layout_.tile);
-  q.enqueueNDRangeKernel(k_limits_, cl::NullRange, cl::NDRange(std::max<cl_uint>(layout_.ntiles, 1)));
+  launch(q, k_limits_, layout_.ntiles);
   std::vector<cl_float2> f(layout_.ntiles);
   std::vector<cl_uint2> ix(layout_.ntiles);
   q.enqueueReadBuffer(limits_f_, CL_FALSE, 0, layout_.ntiles * 8, f.data());

@@ -193,7 +193,7 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
   launch(q, k_heat_, layout_.n);
   set_args(k_budget_, budget_parts_, store_[enthalpy_], layout_.stride, budget_tiles_, budget_bad_, n,
            layout_.tile);
-  q.enqueueNDRangeKernel(k_budget_, cl::NullRange, cl::NDRange(std::max<cl_uint>(layout_.ntiles, 1)));
+  launch(q, k_budget_, layout_.ntiles);
   std::vector<float> sums(std::size_t(layout_.ntiles) * 5);
   std::vector<cl_uint> bad(layout_.ntiles);
   cl_uint changed = 0;

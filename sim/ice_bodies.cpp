@@ -31,15 +31,13 @@ constexpr std::uint32_t kChunk = 256;
 // Sum terms per particle (body_terms in body_sums.cl): m, m r (3), m r r^T (6), f (3), r x f (3).
 constexpr std::size_t kTerms = 16;
 
-// One work-item per tile (or per body): few and long, so pocl picks the group size.
-void launch_few(cl::CommandQueue& q, cl::Kernel& k, std::size_t n) {
-  q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(std::max<std::size_t>(n, 1)));
-}
-
-// About 32 tiles of whole multiples of 256 particles, as the solver's sort: enough work-items for the
-// cores, few enough that per-tile bookkeeping stays small beside the particles.
-std::uint32_t tile_for(std::size_t n) {
-  return static_cast<std::uint32_t>(std::max<std::size_t>(256, (n / 32 + 255) / 256 * 256));
+// Tiles of whole multiples of 256 particles, as many as the solver's layout (ClRuntime::layout_tiles: 32
+// on a CPU, 32 per compute unit on a GPU): enough work-items for the device, few enough that per-tile
+// bookkeeping stays small beside the particles. The per-body sums do not depend on the tiles (the
+// scatter is stable and the pieces are chunks of the grouped order).
+std::uint32_t tile_for(std::size_t n, std::size_t tiles) {
+  const std::size_t per_tile = n / std::max<std::size_t>(tiles, 1);
+  return static_cast<std::uint32_t>(std::max<std::size_t>(256, (per_tile + 255) / 256 * 256));
 }
 
 cl::Buffer buffer(ClRuntime& cl, std::size_t bytes) {
@@ -234,7 +232,7 @@ std::vector<BodySums> BodyReducer::reduce(const BodyParticles& p, const cl::Buff
   if (nbodies == 0 || p.n == 0) return out;
   auto& q = cl_.queue();
   const std::uint32_t n = p.n;
-  const std::uint32_t tile = tile_for(n);
+  const std::uint32_t tile = tile_for(n, cl_.layout_tiles());
   const std::uint32_t ntiles = (n + tile - 1) / tile;
   const std::uint32_t nchunks = (n + kChunk - 1) / kChunk;
   ensure(cl_, hist_, hist_cap_, std::size_t(ntiles) * nbodies, 4);
@@ -250,13 +248,13 @@ std::vector<BodySums> BodyReducer::reduce(const BodyParticles& p, const cl::Buff
   const cl_uint none[2] = {0xffffffffu, 0xffffffffu};
   q.enqueueWriteBuffer(bad_, CL_FALSE, 0, 8, none);
   set_args(k_hist_, p.body, hist_, bad_, n, tile, ntiles, nbodies);
-  launch_few(q, k_hist_, ntiles);
+  launch(q, k_hist_, ntiles);
   set_args(k_scan_, hist_, count_, ntiles, nbodies);
   launch(q, k_scan_, nbodies);
   set_args(k_offsets_, count_, offsets_, nbodies);
-  launch_few(q, k_offsets_, 1);
+  launch(q, k_offsets_, 1);
   set_args(k_scatter_, p.body, hist_, offsets_, order_, n, tile, ntiles, nbodies);
-  launch_few(q, k_scatter_, ntiles);
+  launch(q, k_scatter_, ntiles);
   set_args(k_pieces_, order_, offsets_, p.body, p.position, p.material, mass_scale_, materials_, p.force,
            reference, pieces_, bad_, nbodies, kChunk);
   launch(q, k_pieces_, nchunks);

@@ -108,12 +108,12 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
     const int src = pass % 2, dst = 1 - src;
     const cl_uint shift = radix_bits_ * pass;
     set_args(k_hist_, keys_[src], hist_, shift, n, tile, ntiles);
-    q.enqueueNDRangeKernel(k_hist_, cl::NullRange, cl::NDRange(std::max<cl_uint>(ntiles, 1)));
+    launch(q, k_hist_, ntiles);
     set_args(k_scan_, hist_, totals_, ntiles);
-    q.enqueueNDRangeKernel(k_scan_, cl::NullRange, cl::NDRange(std::size_t(1) << radix_bits_));
+    launch(q, k_scan_, std::size_t(1) << radix_bits_);
     set_args(k_scatter_, keys_[src], order_[src], keys_[dst], order_[dst], hist_, totals_, shift, n, tile,
              ntiles);
-    q.enqueueNDRangeKernel(k_scatter_, cl::NullRange, cl::NDRange(std::max<cl_uint>(ntiles, 1)));
+    launch(q, k_scatter_, ntiles);
   }
   const cl::Buffer& keys = keys_[sort_passes_ % 2];
   const cl::Buffer& order = order_[sort_passes_ % 2];

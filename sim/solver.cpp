@@ -281,7 +281,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   if (ids > 0xffffffffull) throw Error("state: particle ids past 32 bits");
   next_id_ = static_cast<std::uint32_t>(ids);
   if (capacity == 0) capacity = saved.capacity ? saved.capacity : first_capacity(scene_, n_);
-  layout_ = layout_for(n_, capacity);
+  layout_ = layout_for(n_, capacity, cl_.layout_tiles());
   const auto [lo, hi] = particle_bounds(scene_, p);
   const std::string opts = program_options(scene_);
   const HeatPlan plan = plan_heat(scene_, p);

@@ -128,6 +128,7 @@ class Solver {
 
   double time() const { return time_; }
   double dt() const { return dt_; }
+  const ParticleLayout& layout() const { return layout_; }  // the tiles of the per-tile passes
   std::uint64_t steps() const { return steps_; }
   std::uint64_t clamped() const;
   std::size_t size() const { return n_; }

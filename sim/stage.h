@@ -39,14 +39,17 @@ struct ParticleLayout {
   }
 };
 
-// The layout for a capacity of particles, n of them in use: about 32 tiles of the capacity (whole
-// multiples of 256 particles), enough work-items to keep the cores busy, few enough that each tile's
-// per-digit bookkeeping in the sort is small beside its particles; lane loads
+// The layout for a capacity of particles, n of them in use: about `tiles` tiles of the capacity (whole
+// multiples of 256 particles). Each tile is one work-item of the per-tile passes (the sort's histogram
+// and scatter, time-step limits, budgets), which walk their particles in order: a CPU wants few (about
+// 32: enough to keep its cores busy, few enough that each tile's per-digit bookkeeping in the sort is
+// small beside its particles), a GPU thousands (ClRuntime::layout_tiles). Lane loads
 // (sim/kernels/grid_common.h) read up to 15 floats past the last particle.
-inline ParticleLayout layout_for(std::size_t n, std::size_t capacity) {
+inline ParticleLayout layout_for(std::size_t n, std::size_t capacity, std::size_t tiles = 32) {
   ParticleLayout l;
   l.capacity = std::max(n, capacity);
-  l.tile = static_cast<cl_uint>(std::max<std::size_t>(256, (l.capacity / 32 + 255) / 256 * 256));
+  const std::size_t per_tile = l.capacity / std::max<std::size_t>(tiles, 1);
+  l.tile = static_cast<cl_uint>(std::max<std::size_t>(256, (per_tile + 255) / 256 * 256));
   l.max_tiles = static_cast<cl_uint>((l.capacity + l.tile - 1) / l.tile);
   l.stride = static_cast<cl_uint>((l.capacity + 16 + 15) / 16 * 16);
   l.use(n);

@@ -26,7 +26,7 @@ kernel void density(global const float4* pos, global const float* soa, global co
   global const float* Z = soa + 2 * stride;
   global const float* M = soa + 3 * stride;
   floatV acc = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       const floatV dx = pi.x - vloadV(0, X + j);
       const floatV dy = pi.y - vloadV(0, Y + j);
@@ -37,7 +37,7 @@ kernel void density(global const float4* pos, global const float* soa, global co
       const floatV w = vloadV(0, M + j) * w_shape(sqrt(r2) * inv_H);
       acc += select((floatV)(0.0f), w, in);
     }
-  })
+  }
   const float rho = THAW_SIGMA(H) * lanes_sum(acc);
 #ifdef THAW_DFSPH
   /* DFSPH (sim/kernels/dfsph.cl) solves for the pressure after the forces pass: none here. */

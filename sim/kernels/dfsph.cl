@@ -105,12 +105,12 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
     /* A boundary particle only needs to know whether fluid is within reach (the extrapolation takes a
      * pressure from it): the fluid masses within the support, without the kernel. */
     floatV fluid = (floatV)(0.0f);
-    FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+    FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
       for (uint j = jb; j < je; j += THAW_VW) {
         DFSPH_LANES(pi, j, je, H2)
         fluid += select((floatV)(0.0f), vloadV(0, FM + j), in);
       }
-    })
+    }
     col[COL_AD * stride + i] = lanes_sum(fluid) > 0.0f ? -1.0f : 0.0f;
 #else
     col[COL_AD * stride + i] = 0.0f; /* one-sided (akinci2012): nothing is extrapolated, no visit needed */
@@ -119,7 +119,7 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
   }
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
   floatV count = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       DFSPH_LANES(pi, j, je, H2)
       const floatV gf = grad_shape(sqrt(r2) * inv_H); /* ∇W = sigma/H² gf x_ij; the factor comes last */
@@ -130,7 +130,7 @@ kernel void dfsph_alpha(global const float4* pos, global const float* soa, globa
       s += select((floatV)(0.0f), vloadV(0, FM + j) * gf * gf * r2, in);
       count += select((floatV)(0.0f), (floatV)(1.0f), in);
     }
-  })
+  }
   const float scale = THAW_SIGMA(H) * inv_H * inv_H;
   const float3 G = scale * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
   const float S = pi.w * scale * scale * lanes_sum(s);
@@ -152,7 +152,7 @@ float density_rate(const float4 pi, const float3 vi, global const float* soa, gl
   global const float* VY = soa + 5 * stride;
   global const float* VZ = soa + 6 * stride;
   floatV acc = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       DFSPH_LANES(pi, j, je, H2)
       const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
@@ -160,7 +160,7 @@ float density_rate(const float4 pi, const float3 vi, global const float* soa, gl
       const floatV t = vloadV(0, M + j) * grad_shape(sqrt(r2) * inv_H) * vd;
       acc += select((floatV)(0.0f), t, in);
     }
-  })
+  }
   return THAW_SIGMA(H) * inv_H * inv_H * lanes_sum(acc);
 }
 
@@ -213,7 +213,7 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
   global const float* FM = col + COL_FM * stride;
   global const float* KR = col + COL_KR * stride;
   floatV num = (floatV)(0.0f), den = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       DFSPH_LANES(pi, j, je, H2)
       const floatV w = vloadV(0, FM + j) * w_shape(sqrt(r2) * inv_H); /* 0 for boundary neighbours */
@@ -223,7 +223,7 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
       num += select((floatV)(0.0f), w * p, in);
       den += select((floatV)(0.0f), w, in);
     }
-  })
+  }
   const float d = lanes_sum(den), rho = density[i];
   /* No suction: a wall above the water (the gravity term below zero) pushes nothing. */
   col[COL_KR * stride + i] = d > 0.0f ? fmax(lanes_sum(num) / d, 0.0f) / (rho * rho) : 0.0f;
@@ -287,7 +287,7 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
   const float H2 = H * H, inv_H = 1.0f / H;
   DFSPH_SOA(soa, stride)
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       DFSPH_LANES(pi, j, je, H2)
       const floatV t = vloadV(0, M + j) * (kri + vloadV(0, KR + j)) * grad_shape(sqrt(r2) * inv_H);
@@ -295,7 +295,7 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
       ay += select((floatV)(0.0f), t * dy, in);
       az += select((floatV)(0.0f), t * dz, in);
     }
-  })
+  }
   const float3 dv = -dt * THAW_SIGMA(H) * inv_H * inv_H * (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
   const float3 v = vel[i].xyz + dv;
   vel[i] = (float4)(v, 0.0f);
@@ -309,6 +309,7 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
 kernel void dfsph_error_sum(global const float* col, global const uchar* phase, global float2* sums,
                             const uint stride, const uint n, const uint tile) {
   const uint t = get_global_id(0);
+  if (t >= (n + tile - 1) / tile) return;
   const uint b = t * tile, e = min(b + tile, n);
   float sum = 0.0f, count = 0.0f;
   for (uint i = b; i < e; ++i) {

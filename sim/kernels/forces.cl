@@ -65,7 +65,7 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
   const float scale = THAW_SIGMA(H) * inv_H * inv_H;
   const float rep = rep_k / scale; /* the sum below is scaled by `scale` at the end */
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, {
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       const floatV dx = pi.x - vloadV(0, X + j);
       const floatV dy = pi.y - vloadV(0, Y + j);
@@ -87,7 +87,7 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
       ay += select((floatV)(0.0f), s * dy, in);
       az += select((floatV)(0.0f), s * dz, in);
     }
-  })
+  }
   const float3 a = scale * (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
   accel[i] = (float4)(a + gravity.xyz, 0.0f);
 }

@@ -39,23 +39,27 @@ int4 grid_cell(const Grid g, float4 p) {
 
 uint grid_key(const Grid g, int4 c) { return (uint)((c.z * g.ny + c.y) * g.nx + c.x); }
 
-/* Visits the (2 THAW_REACH + 1)^2 rows of cells around cell c; the body sees each row's contiguous range
- * [jb, je) of sorted particles. Kept deliberately simple: the walk's per-row cost is a large part of
- * a pass (measured: trimming rows to the cells that can hold a neighbour visits a quarter fewer
- * candidates but made the density pass slower; see docs/BENCHMARKS.md). */
-#define FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je, ...)                       \
-  for (int dz_ = -THAW_REACH; dz_ <= THAW_REACH; ++dz_) {                            \
-    const int z_ = (c).z + dz_;                                                      \
-    if (z_ < 0 || z_ >= (g).nz) continue;                                            \
-    for (int dy_ = -THAW_REACH; dy_ <= THAW_REACH; ++dy_) {                          \
-      const int y_ = (c).y + dy_;                                                    \
-      if (y_ < 0 || y_ >= (g).ny) continue;                                          \
-      const int row_ = (z_ * (g).ny + y_) * (g).nx;                                  \
-      const uint jb = (cell_start)[row_ + max((c).x - THAW_REACH, 0)];               \
-      const uint je = (cell_start)[row_ + min((c).x + THAW_REACH, (g).nx - 1) + 1];  \
-      __VA_ARGS__                                                                    \
-    }                                                                                \
-  }
+/* The first cell of row (dz, dy) around cell c, or -1 where that row lies outside the grid. */
+int neighbour_row(const Grid g, const int4 c, const int dz, const int dy) {
+  const int z = c.z + dz, y = c.y + dy;
+  return (z < 0 || z >= g.nz || y < 0 || y >= g.ny) ? -1 : (z * g.ny + y) * g.nx;
+}
+
+/* Visits the (2 THAW_REACH + 1)^2 rows of cells around cell c; the statement that follows it sees each
+ * row's contiguous range [jb, je) of sorted particles:
+ *     FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) { ... }
+ * (a `continue` in it goes on to the next row). Written as nested for statements, not as a macro that
+ * takes the body: OpenCL C has no variadic macros, and NVIDIA's compiler refuses them. Kept
+ * deliberately simple: the walk's per-row cost is a large part of a pass (measured: trimming rows to
+ * the cells that can hold a neighbour visits a quarter fewer candidates but made the density pass
+ * slower; see docs/BENCHMARKS.md). */
+#define FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je)                                        \
+  for (int dz_ = -THAW_REACH; dz_ <= THAW_REACH; ++dz_)                                         \
+    for (int dy_ = -THAW_REACH; dy_ <= THAW_REACH; ++dy_)                                       \
+      for (int row_ = neighbour_row(g, c, dz_, dy_); row_ >= 0; row_ = -1)                      \
+        for (uint jb = (cell_start)[row_ + max((c).x - THAW_REACH, 0)],                         \
+                  je = (cell_start)[row_ + min((c).x + THAW_REACH, (g).nx - 1) + 1], once_ = 1; \
+             once_; once_ = 0)
 
 /* SIMD lanes over neighbour candidates: the neighbour passes (density.cl, forces.cl) read THAW_VW
  * consecutive sorted particles at a time (float4/8/16) from structure-of-arrays copies, with per-lane
@@ -87,9 +91,9 @@ float lanes_sum8(float8 a) { return lanes_sum4(a.lo + a.hi); }
 float lanes_sum16(float16 a) { return lanes_sum8(a.lo + a.hi); }
 #define lanes_sum THAW_CAT(lanes_sum, THAW_VW)
 
-/* Visits every particle j in the cells within THAW_REACH of cell c; the body (the trailing argument,
- * commas allowed) sees j. */
-#define FOR_EACH_NEIGHBOUR(g, cell_start, c, ...) \
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb_, je_, for (uint j = jb_; j < je_; ++j) { __VA_ARGS__ })
+/* Visits every particle j in the cells within THAW_REACH of cell c; the statement that follows it sees
+ * j:  FOR_EACH_NEIGHBOUR(g, cell_start, c, j) { ... } */
+#define FOR_EACH_NEIGHBOUR(g, cell_start, c, j) \
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb_, je_) for (uint j = jb_; j < je_; ++j)
 
 #endif

@@ -58,23 +58,19 @@ int wrap_axis(int v, int n, int periodic) { return periodic ? (v + n) % n : v; }
 #else
 #define THAW_PZ 0
 #endif
-#define FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je, ...)                  \
-  for (int dz_ = -1; dz_ <= 1; ++dz_) {                                     \
-    const int z_ = wrap_axis((c).z + dz_, (g).nz, THAW_PZ);                 \
-    if (z_ < 0 || z_ >= (g).nz) continue;                                   \
-    for (int dy_ = -1; dy_ <= 1; ++dy_) {                                   \
-      const int y_ = wrap_axis((c).y + dy_, (g).ny, THAW_PY);               \
-      if (y_ < 0 || y_ >= (g).ny) continue;                                 \
-      for (int dx_ = -1; dx_ <= 1; ++dx_) {                                 \
-        const int x_ = wrap_axis((c).x + dx_, (g).nx, THAW_PX);             \
-        if (x_ < 0 || x_ >= (g).nx) continue;                               \
-        const int cell_ = (z_ * (g).ny + y_) * (g).nx + x_;                 \
-        const uint jb = (cell_start)[cell_];                                \
-        const uint je = (cell_start)[cell_ + 1];                            \
-        __VA_ARGS__                                                         \
-      }                                                                     \
-    }                                                                       \
-  }
+/* The cell (dz, dy, dx) around c with the periodic axes wrapped, or -1 where it lies outside the grid. */
+int heat_cell(const Grid g, const int4 c, const int dz, const int dy, const int dx) {
+  const int z = wrap_axis(c.z + dz, g.nz, THAW_PZ), y = wrap_axis(c.y + dy, g.ny, THAW_PY),
+            x = wrap_axis(c.x + dx, g.nx, THAW_PX);
+  return (z < 0 || z >= g.nz || y < 0 || y >= g.ny || x < 0 || x >= g.nx) ? -1 : (z * g.ny + y) * g.nx + x;
+}
+/* As FOR_EACH_NEIGHBOUR_ROW (grid_common.h), one cell at a time: the statement that follows sees [jb, je). */
+#define FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je)                                              \
+  for (int dz_ = -1; dz_ <= 1; ++dz_)                                                              \
+    for (int dy_ = -1; dy_ <= 1; ++dy_)                                                            \
+      for (int dx_ = -1; dx_ <= 1; ++dx_)                                                          \
+        for (int cell_ = heat_cell(g, c, dz_, dy_, dx_); cell_ >= 0; cell_ = -1)                   \
+          for (uint jb = (cell_start)[cell_], je = (cell_start)[cell_ + 1], once_ = 1; once_; once_ = 0)
 #else
 #define FOR_EACH_HEAT_RANGE FOR_EACH_NEIGHBOUR_ROW
 #endif
@@ -146,7 +142,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
   const float ki = KK[i];
   floatV acc = (floatV)(0.0f);
   intV covered = (intV)(0);
-  FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je, {
+  FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       const floatV dx = THAW_WRAP(pi.x - vloadV(0, X + j), period.x);
       const floatV dy = THAW_WRAP(pi.y - vloadV(0, Y + j), period.y);
@@ -164,7 +160,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
       covered += select((intV)(0), (intV)(1), lane & (r2 < exposed_r2));
 #endif
     }
-  })
+  }
   /* x . grad W = sigma / H^2 grad_shape(q) r^2 (sph_lanes.h). */
   const float Vi = VV[i];
   const float q_conduction = 2.0f * Vi * THAW_SIGMA(H) * inv_H * inv_H * lanes_sum(acc);

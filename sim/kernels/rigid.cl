@@ -55,7 +55,7 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
   const float d2 = contact.distance * contact.distance;
   const int4 c = grid_cell(g, pi);
   float3 f_fluid = (float3)(0.0f), f_contact = (float3)(0.0f);
-  FOR_EACH_NEIGHBOUR(g, cell_start, c, {
+  FOR_EACH_NEIGHBOUR(g, cell_start, c, j) {
     if (j == i) continue;
     const float3 x = pi.xyz - pos[j].xyz;
     const float r2 = dot(x, x);
@@ -79,7 +79,7 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
       const float ft = fmin(contact.friction * fn, contact.damping * st);
       f_contact += fn * normal - (st > 0.0f ? ft / st : 0.0f) * vt;
     }
-  })
+  }
   force[i] = (float4)(pi.w * f_fluid + f_contact, 0.0f);
 }
 

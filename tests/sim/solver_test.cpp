@@ -109,6 +109,35 @@ TEST_F(SolverTest, TwoRunsOfTheSameSceneAreBitwiseIdentical) {
   EXPECT_NE(s0, sa);
 }
 
+// The per-tile passes (the sort, the time-step limits, the heat budget) are cut into 32 tiles on a CPU
+// and thousands on a GPU (ClRuntime::layout_tiles): the particles come out the same whatever the cut,
+// with heat and water leaving through an open side (only the budget's float sums are regrouped).
+TEST_F(SolverTest, TheTileCountChangesNoParticle) {
+  const Scene scene = dam_break(
+      {"domain.walls=[\"-x\", \"-y\", \"+y\", \"-z\"]", "domain.open=[\"+x\"]", "fluids[0].temperature=30"});
+  const SimState start = initial_state(scene);
+  Solver a(cl(), scene, start);
+  ::setenv("THAW_TILES", "7", 1);
+  Solver b(cl(), scene, start);
+  ::unsetenv("THAW_TILES");
+  ASSERT_NE(a.layout().ntiles, b.layout().ntiles);
+  int steps = 0;
+  while (a.outflow().particles == 0 && steps < 20000) {
+    a.step();
+    ++steps;
+  }
+  ASSERT_GT(a.outflow().particles, 0u) << "no water left in " << steps << " steps";
+  run_steps(a, 20);
+  run_steps(b, steps + 20);
+  EXPECT_EQ(a.outflow().particles, b.outflow().particles);
+  const HostParticles pa = a.particles(), pb = b.particles();
+  ASSERT_EQ(pa.size(), pb.size());
+  EXPECT_TRUE(pa.position == pb.position && pa.velocity == pb.velocity && pa.enthalpy == pb.enthalpy &&
+              pa.id == pb.id);
+  EXPECT_NEAR(a.energy_budget().outflow, b.energy_budget().outflow,
+              1e-9 * std::abs(a.energy_budget().outflow));
+}
+
 TEST_F(SolverTest, ResumingFromAStateFileContinuesBitwiseIdentically) {
   const Scene scene = dam_break();
   TempDir dir("resume");
@@ -459,7 +488,13 @@ TEST_F(SolverTest, WaterLeavingThroughAnOpenSideIsRemovedAndBooked) {
     EXPECT_EQ(s.clamped(), 0u) << "nothing is held at the open side (the others hold no water here)";
     EXPECT_GT(s.energy_budget().outflow, 0.0);
     EXPECT_LT(std::abs(m.closure()), 1e-9 * m.enthalpy_scale) << "the enthalpy books close with the outflow";
-    for (const Float4& x : s.particles().position) ASSERT_LE(x[0], scene.domain.max.x() + 1e-6);
+    // A particle past the open side is removed at the next step's grid build: one there now crossed it
+    // in this step's drift (x = x_before + v dt), which device rounding decides (a GPU left one 0.6 mm
+    // past it where pocl left none).
+    const HostParticles p = s.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      ASSERT_LE(p.position[i][0] - p.velocity[i][0] * s.dt(), scene.domain.max.x() + 1e-6)
+          << "particle " << i;
   }
 
   // Resumed after particles have left: bit for bit, the books included.

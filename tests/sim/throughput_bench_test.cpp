@@ -43,8 +43,14 @@ TEST_F(ThroughputBench, RunsAtSmallSizesAndAgreesWithItsReferenceLoops) {
     const double fluid = row["fluid_particles"].get<double>();
     EXPECT_NEAR(fluid / double(o.sizes[k]), 1.0, 0.1) << row.dump();
     EXPECT_GT(row["stage_us"]["step"].get<double>(), 0.0);
-    // The lanes loop sums in the device's order: bitwise; the scalar loop within float rounding.
-    EXPECT_EQ(row["reference_lanes_max_rel_diff_rho"].get<double>(), 0.0);
+    // The lanes loop sums in the device's order: bitwise on pocl, which rounds each product as the loop
+    // does; a GPU compiler fuses multiply-adds (-cl-mad-enable), 3e-7 on an NVIDIA H200. The scalar loop
+    // within float rounding.
+    const double lanes = row["reference_lanes_max_rel_diff_rho"].get<double>();
+    if (cl().info().type == "CPU")
+      EXPECT_EQ(lanes, 0.0);
+    else
+      EXPECT_LT(lanes, 1e-5);
     EXPECT_LT(row["reference_scalar_max_rel_diff_rho"].get<double>(), 1e-5);
     EXPECT_LT(row["reference_heat_max_rel_diff_q"].get<double>(), 1e-5);
   }
