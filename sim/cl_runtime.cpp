@@ -115,7 +115,7 @@ DeviceInfo choose_device(const std::string& requested) {
 }
 
 std::size_t ClRuntime::layout_tiles() const {
-  if (const char* env = std::getenv("THAW_TILES")) {
+  if (const char* env = std::getenv("THAW_TILES"); env && *env) {  // set and not empty
     char* end = nullptr;
     const long v = std::strtol(env, &end, 10);
     if (end == env || *end != '\0' || v < 1 || v > (1 << 24))

@@ -49,7 +49,8 @@ class ClRuntime {
   const DeviceInfo& info() const { return info_; }
 
   // How many tiles the particles are cut into for the per-tile passes (layout_for in sim/stage.h): 32
-  // on a CPU, 32 per compute unit on a GPU; $THAW_TILES overrides it (for `thaw bench`).
+  // on a CPU, 32 per compute unit on a GPU; $THAW_TILES, when set and not empty, overrides it (for `thaw
+  // bench`).
   std::size_t layout_tiles() const;
   std::string description() const;
   cl::Context& context() { return context_; }

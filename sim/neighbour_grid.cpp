@@ -10,6 +10,11 @@
 
 namespace thaw {
 
+namespace {
+// Tiles per chunk of the sort's scan (grid.cl): at most this many tiles are scanned in one walk per digit.
+constexpr cl_uint kScanChunk = 32;
+}  // namespace
+
 ClGrid cl_grid(const GridInfo& gi) {
   return {{{gi.origin.x(), gi.origin.y(), gi.origin.z(), 0.f}},
           {{1.0f / gi.cells.x(), 1.0f / gi.cells.y(), 1.0f / gi.cells.z(), 0.f}},
@@ -63,10 +68,14 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   radix_bits_ = static_cast<std::uint32_t>((bits + int(sort_passes_) - 1) / int(sort_passes_));
 
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "grid.cl"},
-                                build_options + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_));
+                                build_options + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_) +
+                                    " -DTHAW_SCAN_CHUNK=" + std::to_string(kScanChunk));
   k_cell_keys_ = cl::Kernel(program, "cell_keys");
   k_hist_ = cl::Kernel(program, "radix_histogram");
   k_scan_ = cl::Kernel(program, "radix_scan_rows");
+  k_chunk_counts_ = cl::Kernel(program, "radix_chunk_counts");
+  k_scan_chunks_ = cl::Kernel(program, "radix_scan_chunks");
+  k_scan_tiles_ = cl::Kernel(program, "radix_scan_tiles");
   k_scatter_ = cl::Kernel(program, "radix_scatter");
   k_starts_ = cl::Kernel(program, "cell_starts");
 
@@ -81,6 +90,8 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   }
   hist_ = buf((std::size_t(1) << radix_bits_) * std::max<cl_uint>(layout.max_tiles, 1) * 4);
   totals_ = buf((std::size_t(1) << radix_bits_) * 4);
+  chunks_ = buf((std::size_t(1) << radix_bits_) *
+                ((std::max<cl_uint>(layout.max_tiles, 1) + kScanChunk - 1) / kScanChunk) * 4);
   cell_start_ = buf((std::size_t(ncells_) + 1) * 4);
   soa_ = buf(std::size_t(layout.stride) * 7 * 4);
   // The padding past the last particle is read by masked lanes only; keep it finite anyway.
@@ -109,8 +120,19 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
     const cl_uint shift = radix_bits_ * pass;
     set_args(k_hist_, keys_[src], hist_, shift, n, tile, ntiles);
     launch(q, k_hist_, ntiles);
-    set_args(k_scan_, hist_, totals_, ntiles);
-    launch(q, k_scan_, std::size_t(1) << radix_bits_);
+    const std::size_t digits = std::size_t(1) << radix_bits_;
+    if (ntiles <= kScanChunk) {  // a CPU's 32 tiles: one walk per digit
+      set_args(k_scan_, hist_, totals_, ntiles);
+      launch(q, k_scan_, digits);
+    } else {  // a GPU's thousands: in chunks (grid.cl)
+      const cl_uint nchunks = (ntiles + kScanChunk - 1) / kScanChunk;
+      set_args(k_chunk_counts_, hist_, chunks_, ntiles, nchunks);
+      launch(q, k_chunk_counts_, digits * nchunks);
+      set_args(k_scan_chunks_, chunks_, totals_, nchunks);
+      launch(q, k_scan_chunks_, digits);
+      set_args(k_scan_tiles_, hist_, chunks_, ntiles, nchunks);
+      launch(q, k_scan_tiles_, digits * nchunks);
+    }
     set_args(k_scatter_, keys_[src], order_[src], keys_[dst], order_[dst], hist_, totals_, shift, n, tile,
              ntiles);
     launch(q, k_scatter_, ntiles);

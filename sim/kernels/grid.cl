@@ -56,17 +56,53 @@ kernel void radix_histogram(global const uint* keys, global uint* hist, const ui
   for (uint i = t * tile; i < e; ++i) hist[((keys[i] >> shift) & THAW_RADIX_MASK) * ntiles + t] += 1;
 }
 
+/* Exclusive scan of `count` consecutive counts in place, starting from `sum`; returns the sum past them. */
+uint scan_counts(global uint* row, const uint count, uint sum) {
+  for (uint k = 0; k < count; ++k) {
+    const uint c = row[k];
+    row[k] = sum;
+    sum += c;
+  }
+  return sum;
+}
+
 /* Exclusive scan of each digit's row of tile counts; the row total goes to totals[d]. */
 kernel void radix_scan_rows(global uint* hist, global uint* totals, const uint ntiles) {
   const uint d = get_global_id(0);
   if (d >= THAW_RADIX_BUCKETS) return;
+  totals[d] = scan_counts(hist + (size_t)d * ntiles, ntiles, 0u);
+}
+
+/* The same scan in chunks of THAW_SCAN_CHUNK tiles, for a GPU's thousands of tiles, where one work-item
+ * per digit walking every tile is a long chain of dependent loads: (1) each (digit, chunk) counts its
+ * chunk, (2) each digit scans its chunks' counts, (3) each (digit, chunk) scans its tiles from its
+ * chunk's offset. Integer sums: the result is the serial scan's, bit for bit. */
+#ifndef THAW_SCAN_CHUNK
+#define THAW_SCAN_CHUNK 32
+#endif
+kernel void radix_chunk_counts(global const uint* hist, global uint* chunks, const uint ntiles,
+                               const uint nchunks) {
+  const uint k = get_global_id(0);
+  if (k >= THAW_RADIX_BUCKETS * nchunks) return;
+  const uint d = k / nchunks, c = k % nchunks;
+  const uint e = min(ntiles, (c + 1) * THAW_SCAN_CHUNK);
   uint sum = 0;
-  for (uint t = 0; t < ntiles; ++t) {
-    const uint c = hist[d * ntiles + t];
-    hist[d * ntiles + t] = sum;
-    sum += c;
-  }
-  totals[d] = sum;
+  for (uint t = c * THAW_SCAN_CHUNK; t < e; ++t) sum += hist[d * ntiles + t];
+  chunks[k] = sum;
+}
+
+kernel void radix_scan_chunks(global uint* chunks, global uint* totals, const uint nchunks) {
+  const uint d = get_global_id(0);
+  if (d >= THAW_RADIX_BUCKETS) return;
+  totals[d] = scan_counts(chunks + (size_t)d * nchunks, nchunks, 0u);
+}
+
+kernel void radix_scan_tiles(global uint* hist, global const uint* chunks, const uint ntiles, const uint nchunks) {
+  const uint k = get_global_id(0);
+  if (k >= THAW_RADIX_BUCKETS * nchunks) return;
+  const uint d = k / nchunks, c = k % nchunks;
+  const uint b = c * THAW_SCAN_CHUNK, e = min(ntiles, b + THAW_SCAN_CHUNK);
+  scan_counts(hist + (size_t)d * ntiles + b, e - b, chunks[k]);
 }
 
 kernel void radix_scatter(global const uint* keys_in, global const uint* vals_in, global uint* keys_out,
