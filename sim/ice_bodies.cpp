@@ -8,6 +8,7 @@
 #include "sim/cl_launch.h"
 #include "sim/error.h"
 #include "sim/particles.h"
+#include "sim/stage.h"
 
 namespace thaw {
 namespace {
@@ -30,15 +31,6 @@ constexpr std::uint32_t kChunk = 256;
 
 // Sum terms per particle (body_terms in body_sums.cl): m, m r (3), m r r^T (6), f (3), r x f (3).
 constexpr std::size_t kTerms = 16;
-
-// Tiles of whole multiples of 256 particles, as many as the solver's layout (ClRuntime::layout_tiles: 32
-// on a CPU, 32 per compute unit on a GPU): enough work-items for the device, few enough that per-tile
-// bookkeeping stays small beside the particles. The per-body sums do not depend on the tiles (the
-// scatter is stable and the pieces are chunks of the grouped order).
-std::uint32_t tile_for(std::size_t n, std::size_t tiles) {
-  const std::size_t per_tile = n / std::max<std::size_t>(tiles, 1);
-  return static_cast<std::uint32_t>(std::max<std::size_t>(256, (per_tile + 255) / 256 * 256));
-}
 
 cl::Buffer buffer(ClRuntime& cl, std::size_t bytes) {
   return cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
@@ -232,7 +224,9 @@ std::vector<BodySums> BodyReducer::reduce(const BodyParticles& p, const cl::Buff
   if (nbodies == 0 || p.n == 0) return out;
   auto& q = cl_.queue();
   const std::uint32_t n = p.n;
-  const std::uint32_t tile = tile_for(n, cl_.layout_tiles());
+  // The solver's tiles (sim/stage.h): 32 on a CPU, thousands on a GPU. The per-body sums do not depend on
+  // them (the scatter is stable and the pieces are chunks of the grouped order).
+  const std::uint32_t tile = layout_for(n, n, cl_.layout_tiles()).tile;
   const std::uint32_t ntiles = (n + tile - 1) / tile;
   const std::uint32_t nchunks = (n + kChunk - 1) / kChunk;
   ensure(cl_, hist_, hist_cap_, std::size_t(ntiles) * nbodies, 4);
