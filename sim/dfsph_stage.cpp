@@ -97,7 +97,8 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
   auto extrapolate = [&](bool hydrostatic) {
     if (!extrapolate_) return;
     set_args(k_extrapolate_, store_[f_.position], nv.soa, store_[f_.density], store_[f_.phase], col_,
-             nv.cell_start, nv.grid, support_, gravity_, cl_int(hydrostatic ? 1 : 0), layout_.stride, n);
+             nv.cell_start, nv.grid, support_, gravity_, cl_int(hydrostatic ? 1 : 0),
+             static_cast<float>(rest_density_), layout_.stride, n);
     launch(q, k_extrapolate_, layout_.n);
   };
   extrapolate(density_mode);

@@ -193,7 +193,12 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
 }
 
 /* A boundary particle's KR from the fluid around it (Adami et al. 2012, eq 27, the wall's acceleration
- * left out): p_b = Σ_f m_f W_bf (p_f + ρ_f g·(x_b - x_f)) / Σ_f m_f W_bf, p_f = KR_f ρ_f², KR_b = p_b / ρ_b².
+ * left out): p_b = Σ_f m_f W_bf (p_f + ρ_f g·(x_b - x_f)) / Σ_f m_f W_bf, p_f = KR_f ρ_f², KR_b = p_b / ρ_b²
+ * with ρ_b the density the fluid's equation of state gives p_b (Adami's eq 28), which for an
+ * incompressible fluid is its rest density ρ0, not the boundary particle's summed density: that runs
+ * below ρ0 where the boundary's own neighbourhood is thin (a body's edges and waterline), and with it
+ * the water pushed a prism held at Archimedes' draft with 1.022 of its weight (1.008 with ρ0, density
+ * tolerance 0.01 %), floating it at 0.894 of its height below the water's mass level (0.902 with ρ0).
  * The gravity term is a pressure, not an increment: it enters once a step, with the density solve's warm
  * start (`hydrostatic` 1), where the solve meets gravity; later sweeps extrapolate the increments alone.
  * It gives the boundary layer the pressure at its own depth rather than that of the fluid a spacing
@@ -202,7 +207,7 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
 kernel void dfsph_extrapolate(global const float4* pos, global const float* soa, global const float* density,
                               global const uchar* phase, global float* col, global const uint* cell_start,
                               const Grid g, const float H, const float4 gravity, const int hydrostatic,
-                              const uint stride, const uint n) {
+                              const float rest_density, const uint stride, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   if (!THAW_IS_STATIC(phase[i]) || col[COL_AD * stride + i] >= 0.0f) return; /* flagged -1 by dfsph_alpha */
@@ -224,9 +229,9 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
       den += select((floatV)(0.0f), w, in);
     }
   }
-  const float d = lanes_sum(den), rho = density[i];
+  const float d = lanes_sum(den);
   /* No suction: a wall above the water (the gravity term below zero) pushes nothing. */
-  col[COL_KR * stride + i] = d > 0.0f ? fmax(lanes_sum(num) / d, 0.0f) / (rho * rho) : 0.0f;
+  col[COL_KR * stride + i] = d > 0.0f ? fmax(lanes_sum(num) / d, 0.0f) / (rest_density * rest_density) : 0.0f;
 }
 
 /* The warm start (2017 §4.3): last step's accumulated κ of this solve as this iteration's KR; the
