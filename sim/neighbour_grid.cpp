@@ -11,7 +11,7 @@
 namespace thaw {
 
 namespace {
-// Tiles per chunk of the sort's scan (grid.cl): at most this many tiles are scanned in one walk per digit.
+// Tiles per chunk of the sort's scan (grid.cl): a CPU's 32 tiles are one chunk, a GPU's thousands many.
 constexpr cl_uint kScanChunk = 32;
 }  // namespace
 
@@ -72,7 +72,6 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
                                     " -DTHAW_SCAN_CHUNK=" + std::to_string(kScanChunk));
   k_cell_keys_ = cl::Kernel(program, "cell_keys");
   k_hist_ = cl::Kernel(program, "radix_histogram");
-  k_scan_ = cl::Kernel(program, "radix_scan_rows");
   k_chunk_counts_ = cl::Kernel(program, "radix_chunk_counts");
   k_scan_chunks_ = cl::Kernel(program, "radix_scan_chunks");
   k_scan_tiles_ = cl::Kernel(program, "radix_scan_tiles");
@@ -120,19 +119,15 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
     const cl_uint shift = radix_bits_ * pass;
     set_args(k_hist_, keys_[src], hist_, shift, n, tile, ntiles);
     launch(q, k_hist_, ntiles);
+    // The digits' rows of tile counts scanned in chunks of tiles (grid.cl).
     const std::size_t digits = std::size_t(1) << radix_bits_;
-    if (ntiles <= kScanChunk) {  // a CPU's 32 tiles: one walk per digit
-      set_args(k_scan_, hist_, totals_, ntiles);
-      launch(q, k_scan_, digits);
-    } else {  // a GPU's thousands: in chunks (grid.cl)
-      const cl_uint nchunks = (ntiles + kScanChunk - 1) / kScanChunk;
-      set_args(k_chunk_counts_, hist_, chunks_, ntiles, nchunks);
-      launch(q, k_chunk_counts_, digits * nchunks);
-      set_args(k_scan_chunks_, chunks_, totals_, nchunks);
-      launch(q, k_scan_chunks_, digits);
-      set_args(k_scan_tiles_, hist_, chunks_, ntiles, nchunks);
-      launch(q, k_scan_tiles_, digits * nchunks);
-    }
+    const cl_uint nchunks = (ntiles + kScanChunk - 1) / kScanChunk;
+    set_args(k_chunk_counts_, hist_, chunks_, ntiles, nchunks);
+    launch(q, k_chunk_counts_, digits * nchunks);
+    set_args(k_scan_chunks_, chunks_, totals_, nchunks);
+    launch(q, k_scan_chunks_, digits);
+    set_args(k_scan_tiles_, hist_, chunks_, ntiles, nchunks);
+    launch(q, k_scan_tiles_, digits * nchunks);
     set_args(k_scatter_, keys_[src], order_[src], keys_[dst], order_[dst], hist_, totals_, shift, n, tile,
              ntiles);
     launch(q, k_scatter_, ntiles);

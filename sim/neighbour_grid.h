@@ -54,8 +54,7 @@ class NeighbourGrid {
   const ParticleLayout& layout_;
   GridInfo info_;
   std::uint32_t ncells_ = 0, sort_passes_ = 0, radix_bits_ = 8;
-  cl::Kernel k_cell_keys_, k_hist_, k_scan_, k_chunk_counts_, k_scan_chunks_, k_scan_tiles_, k_scatter_,
-      k_starts_;
+  cl::Kernel k_cell_keys_, k_hist_, k_chunk_counts_, k_scan_chunks_, k_scan_tiles_, k_scatter_, k_starts_;
   cl::Buffer keys_[2], order_[2], hist_, totals_, chunks_, cell_start_, soa_;
 };
 

@@ -66,17 +66,11 @@ uint scan_counts(global uint* row, const uint count, uint sum) {
   return sum;
 }
 
-/* Exclusive scan of each digit's row of tile counts; the row total goes to totals[d]. */
-kernel void radix_scan_rows(global uint* hist, global uint* totals, const uint ntiles) {
-  const uint d = get_global_id(0);
-  if (d >= THAW_RADIX_BUCKETS) return;
-  totals[d] = scan_counts(hist + (size_t)d * ntiles, ntiles, 0u);
-}
-
-/* The same scan in chunks of THAW_SCAN_CHUNK tiles, for a GPU's thousands of tiles, where one work-item
- * per digit walking every tile is a long chain of dependent loads: (1) each (digit, chunk) counts its
- * chunk, (2) each digit scans its chunks' counts, (3) each (digit, chunk) scans its tiles from its
- * chunk's offset. Integer sums: the result is the serial scan's, bit for bit. */
+/* Exclusive scan of each digit's row of tile counts (hist[d * ntiles + t]), the row totals to totals[d],
+ * in chunks of THAW_SCAN_CHUNK tiles, so that a GPU's thousands of tiles are not one work-item per digit
+ * walking all of them (a long chain of dependent loads): (1) each (digit, chunk) counts its chunk, (2)
+ * each digit scans its chunks' counts, (3) each (digit, chunk) scans its tiles from its chunk's offset.
+ * Integer sums: the result is the serial scan's, bit for bit. A CPU's 32 tiles are one chunk. */
 #ifndef THAW_SCAN_CHUNK
 #define THAW_SCAN_CHUNK 32
 #endif
