@@ -24,7 +24,8 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   std::ostringstream relaxation;
   relaxation.precision(9);
   relaxation << build_options << " -DTHAW_OMEGA=" << scene.solver.pressure_relaxation << "f";
-  if (scene.solver.boundary_pressure == DfsphBoundary::Adami2012) relaxation << " -DTHAW_DFSPH_EXTRAPOLATE";
+  extrapolate_ = scene.solver.boundary_pressure == DfsphBoundary::Adami2012;
+  if (extrapolate_) relaxation << " -DTHAW_DFSPH_EXTRAPOLATE";
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph.cl"},
                                 relaxation.str());
   k_columns_ = cl::Kernel(program, "dfsph_columns");
@@ -46,7 +47,6 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   min_neighbours_ = static_cast<cl_uint>(std::lround(0.6 * full));
   rest_density_ = k.rest_density;
   density_tolerance_ = scene.solver.density_tolerance;
-  extrapolate_ = scene.solver.boundary_pressure == DfsphBoundary::Adami2012;
   divergence_tolerance_ = scene.solver.divergence_tolerance;
   max_iterations_ = scene.solver.max_pressure_iterations;
   col_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::size_t(layout.stride) * kColumns * 4);

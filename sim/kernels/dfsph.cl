@@ -260,9 +260,6 @@ kernel void dfsph_warm(global const float* density, global const uchar* phase, g
   kappa[i] = acc;
 }
 
-/* The second half: v_i -= dt Σ_j m_j (KR_i + KR_j) ∇W_ij, written to vel and to the soa copy the lanes
- * read. Boundary neighbours enter with their extrapolated KR and their Ψ. The κ applied is added to the
- * accumulator: κ dt² (density_mode) or κ dt. */
 /* Adds the κ a sweep applied to particle i's accumulator: κ dt² (density_mode) or κ dt. */
 void book_kappa(global float2* kappa, const uint i, const float k, const float dt, const int density_mode) {
   float2 acc = kappa[i];
@@ -273,6 +270,9 @@ void book_kappa(global float2* kappa, const uint i, const float k, const float d
   kappa[i] = acc;
 }
 
+/* The second half: v_i -= dt Σ_j m_j (KR_i + KR_j) ∇W_ij, written to vel and to the soa copy the lanes
+ * read. Boundary neighbours enter with their extrapolated KR and their Ψ. The κ applied is booked
+ * (book_kappa), by boundary particles too. */
 kernel void dfsph_correct(global float4* vel, global float* soa, global const uchar* phase, global const float* col,
                           global const float4* pos, global const float* density, global float2* kappa,
                           global const uint* cell_start, const Grid g, const float H, const float dt,
