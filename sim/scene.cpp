@@ -512,7 +512,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
         throw SceneError(
             "solver.pressure",
             "dfsph does not float free ice yet (ice[" + std::to_string(b) +
-                "] has motion free; in the floating case its draft is 2-5 % off at the default step): "
+                "] has motion free; in the floating case its draft is 1.6-5 % off at the default step): "
                 "use wcsph for scenes with free ice, or make the ice fixed");
   if (s.solver.min_dt >= s.solver.max_dt) {
     throw SceneError("solver.min_dt", format_number(s.solver.min_dt) + " s must be below solver.max_dt (" +
