@@ -500,20 +500,6 @@ Scene convert_and_check(Json doc, const std::string& folder) {
                                     "; increase the spacing, shrink the scene, or set THAW_MEMORY_LIMIT "
                                     "(e.g. THAW_MEMORY_LIMIT=32G, or off) to override");
   }
-  // DFSPH hands rigid ice the reaction of its solves' impulses, but that coupling does not float ice
-  // within the 1 % yet: with the walls' and ice's pressure extrapolated (sim/kernels/dfsph.cl) the
-  // prism of `thaw validate floating --res 10 --set solver.pressure=dfsph --set run_time=1` floats at a
-  // draft of 0.902 of its height below the water's mass level and 0.868 below its surface, against 0.917
-  // (WCSPH: 0.919 and 0.875), while the narrow prism capsizes as it should (92.6 degrees against 90).
-  // Refuse it rather than give the user's ice a wrong draft.
-  if (s.solver.pressure == PressureSolver::Dfsph)
-    for (std::size_t b = 0; b < s.ice.size(); ++b)
-      if (s.ice[b].motion == IceBlock::Motion::Free)
-        throw SceneError(
-            "solver.pressure",
-            "dfsph does not float free ice yet (ice[" + std::to_string(b) +
-                "] has motion free; in the floating case its draft is 1.6-5 % off at the default step): "
-                "use wcsph for scenes with free ice, or make the ice fixed");
   if (s.solver.min_dt >= s.solver.max_dt) {
     throw SceneError("solver.min_dt", format_number(s.solver.min_dt) + " s must be below solver.max_dt (" +
                                           format_number(s.solver.max_dt) + " s)");

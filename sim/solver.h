@@ -213,6 +213,9 @@ class Solver {
   std::unique_ptr<FluidStage> fluid_;
   // The incompressible pressure solver (sim/dfsph_stage.h), built only when solver.pressure is dfsph.
   std::unique_ptr<DfsphStage> dfsph_;
+  // DFSPH with free ice: the velocities the forces pass saw, kept for rigid ice's viscous reaction (the
+  // solves change the water's velocities before the ice takes it).
+  cl::Buffer forces_velocity_;
   void step_dfsph();
   // Particles clamped back into the domain (counted by the grid's cell-key pass).
   cl::Buffer clamped_;

@@ -116,22 +116,33 @@ std::string state_bytes(const Solver& s, const TempDir& dir, const std::string& 
 
 // Determinism: two runs give the same bytes; a run resumed from a state file mid-run (the warm-start
 // kappa and the last dt are in it) continues bitwise.
-TEST_F(DfsphTest, TwoRunsAndAResumedRunAreBitwiseTheSame) {
-  const Scene s = load_scene("dam-break", {"spacing=0.025", "solver.pressure=dfsph"});
+void expect_runs_and_resume_bitwise(ClRuntime& cl, const Scene& s, int half) {
   TempDir dir("dfsph-resume");
-  Solver a(cl(), s, initial_state(s));
-  for (int i = 0; i < 20; ++i) a.step();
+  Solver a(cl, s, initial_state(s));
+  for (int i = 0; i < half; ++i) a.step();
   write_state_file(dir / "mid.state", a.state());
-  for (int i = 0; i < 20; ++i) a.step();
+  for (int i = 0; i < half; ++i) a.step();
   const std::string expected = state_bytes(a, dir, "a.state");
 
-  Solver b(cl(), s, initial_state(s));
-  for (int i = 0; i < 40; ++i) b.step();
+  Solver b(cl, s, initial_state(s));
+  for (int i = 0; i < 2 * half; ++i) b.step();
   EXPECT_TRUE(state_bytes(b, dir, "b.state") == expected) << "two runs differ";
 
-  Solver resumed(cl(), s, read_state_file(dir / "mid.state"));
+  Solver resumed(cl, s, read_state_file(dir / "mid.state"));
   while (resumed.steps() < a.steps()) resumed.step();
   EXPECT_TRUE(state_bytes(resumed, dir, "resumed.state") == expected) << "the resumed run differs";
+}
+
+TEST_F(DfsphTest, TwoRunsAndAResumedRunAreBitwiseTheSame) {
+  expect_runs_and_resume_bitwise(cl(), load_scene("dam-break", {"spacing=0.025", "solver.pressure=dfsph"}),
+                                 20);
+}
+
+// The same with free ice bodies floating and melting in warm water (the default scene, coarse).
+TEST_F(DfsphTest, FreeIceInWarmWaterResumesBitwise) {
+  const Scene s = load_scene("default", {"spacing=0.006", "solver.pressure=dfsph"});
+  ASSERT_FALSE(s.ice.empty());
+  expect_runs_and_resume_bitwise(cl(), s, 15);
 }
 
 // A tolerance two sweeps cannot meet is reported, step by step, in the metrics: never passed over.
@@ -256,19 +267,6 @@ TEST_F(DfsphTest, WallsCarryTheFullLoadWithTheirExtrapolatedPressure) {
       adami, akinci);
   EXPECT_GT(adami, 0.4);
   EXPECT_LT(akinci, adami - 0.1);
-}
-
-// Free ice does not float under DFSPH yet: a scene that asks for both is refused, naming the path.
-TEST(DfsphScene, FreeIceIsRefusedNamingThePath) {
-  try {
-    load_scene("default", {"solver.pressure=dfsph"});
-    FAIL() << "dfsph with free ice was accepted";
-  } catch (const SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("solver.pressure"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("ice[0]"), std::string::npos) << e.what();
-  }
-  EXPECT_NO_THROW(load_scene("icicles-lamp", {"solver.pressure=dfsph", "ice[1].motion=fixed", "ice[2].motion=fixed",
-                                              "ice[3].motion=fixed"}));
 }
 
 }  // namespace

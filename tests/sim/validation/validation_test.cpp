@@ -225,5 +225,37 @@ TEST_F(Validation, FloatingNarrowPrismCapsizesOntoItsSide) {
   EXPECT_EQ(r.metrics[0].second.reference, 90.0);
 }
 
+// Free ice under DFSPH (issue 17): the same prism at the default step and tolerances. Its draft below the
+// water's mass level (Archimedes' level: the pressure under the prism is g times the mass above) comes out
+// about 0.15 spacings short of 0.917 at every resolution measured (0.155 at res 8, 0.150 at 10, 0.145 at
+// 12, 0.142 at 14, 0.093 at 16; docs/VALIDATION-RESULTS.md), so it falls as 1/res and is within 1 % of
+// the height from res 16 on; here it is gated at the case's gate and at 0.2 spacings. The surface draft
+// stays 0.45-0.49 spacings off at every resolution against the case's half-spacing gate (WCSPH: 0.37-0.41),
+// so at this resolution it is printed, not asserted: it would pass or fail with the CPU's rounding.
+TEST_F(Validation, FloatingWidePrismUnderDfsphFloatsWithinAFifthOfASpacing) {
+  const int res = 10;
+  const CaseResult r =
+      run_validation(cl(), "floating", res, {"breadth_ratio=1.0", "run_time=1", "solver.pressure=dfsph"});
+  print(r);
+  ASSERT_EQ(r.metrics.size(), 3u);
+  EXPECT_EQ(r.metrics[0].first, "heel_degrees");
+  EXPECT_LE(r.metrics[0].second.error, r.metrics[0].second.gate);
+  const auto& [name, draft] = r.metrics[2];
+  EXPECT_EQ(name, "draft_below_mass_level_over_height");
+  EXPECT_LE(draft.error, draft.gate);
+  EXPECT_LT(draft.error, 0.2 / res);
+}
+
+// The narrow prism of FloatingNarrowPrismCapsizesOntoItsSide, under DFSPH: it capsizes onto its side too.
+TEST_F(Validation, FloatingNarrowPrismCapsizesUnderDfsph) {
+  const CaseResult r = run_validation(
+      cl(), "floating", 12,
+      {"breadth_ratio=0.5", "margin=0.35", "depth=1.1", "run_time=2.5", "solver.pressure=dfsph"});
+  print(r);
+  EXPECT_TRUE(r.passed());
+  ASSERT_EQ(r.metrics.size(), 1u);
+  EXPECT_EQ(r.metrics[0].second.reference, 90.0);
+}
+
 }  // namespace
 }  // namespace thaw
