@@ -6,12 +6,26 @@
 #include <vector>
 
 #include "sim/cl_launch.h"
+#include "sim/kernels/sph_kernel.h"
 #include "sim/solver.h"
 
 namespace thaw {
 
 namespace {
 constexpr int kColumns = 5;  // FM, KR, AD, AV, ERR (sim/kernels/dfsph.cl)
+}
+
+double lattice_sum(KernelFunction kernel, double spacing, double support) {
+  const int reach = static_cast<int>(std::ceil(support / spacing));
+  double sum = 0;
+  for (int x = -reach; x <= reach; ++x)
+    for (int y = -reach; y <= reach; ++y)
+      for (int z = -reach; z <= reach; ++z) {
+        const auto r = static_cast<float>(spacing * std::sqrt(double(x * x + y * y + z * z)));
+        const auto H = static_cast<float>(support);
+        sum += kernel == KernelFunction::WendlandC2 ? sph::wendland_c2_w(r, H) : sph::cubic_spline_w(r, H);
+      }
+  return sum * spacing * spacing * spacing;
 }
 
 DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
@@ -23,9 +37,11 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   kappa_ = store.add({"dfsph_kappa", FieldType::Float32, 2});
   std::ostringstream relaxation;
   relaxation.precision(9);
+  relaxation << std::showpoint;  // 1 as "1.00000000f": OpenCL C has no "1f"
   relaxation << build_options << " -DTHAW_OMEGA=" << scene.solver.pressure_relaxation << "f";
   extrapolate_ = scene.solver.boundary_pressure == DfsphBoundary::Adami2012;
   if (extrapolate_) relaxation << " -DTHAW_DFSPH_EXTRAPOLATE";
+  relaxation << " -DTHAW_DFSPH_LATTICE=" << lattice_sum(scene.solver.kernel, scene.spacing, k.support) << "f";
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph.cl"},
                                 relaxation.str());
   k_columns_ = cl::Kernel(program, "dfsph_columns");

@@ -227,11 +227,10 @@ TEST_F(Validation, FloatingNarrowPrismCapsizesOntoItsSide) {
 
 // Free ice under DFSPH (issue 17): the same prism at the default step and tolerances. Its draft below the
 // water's mass level (Archimedes' level: the pressure under the prism is g times the mass above) comes out
-// about 0.15 spacings short of 0.917 at every resolution measured (0.155 at res 8, 0.150 at 10, 0.145 at
-// 12, 0.142 at 14, 0.093 at 16; docs/VALIDATION-RESULTS.md), so it falls as 1/res and is within 1 % of
-// the height from res 16 on; here it is gated at the case's gate and at 0.2 spacings. The surface draft
-// stays 0.45-0.49 spacings off at every resolution against the case's half-spacing gate (WCSPH: 0.37-0.41),
-// so at this resolution it is printed, not asserted: it would pass or fail with the CPU's rounding.
+// short of 0.917 by 0.112 spacings at res 10, 0.085 at 12, 0.031 at 14 and 0.076 at 16
+// (docs/VALIDATION-RESULTS.md): within 1 % of the height from res 12 on; here it is gated at the case's
+// gate and at 0.2 spacings. The surface draft sits 0.41-0.50 spacings above it, at the edge of the case's
+// half-spacing gate (1.04 of it at res 10), so it is printed, not asserted.
 TEST_F(Validation, FloatingWidePrismUnderDfsphFloatsWithinAFifthOfASpacing) {
   const int res = 10;
   const CaseResult r =
