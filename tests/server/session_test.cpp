@@ -445,6 +445,23 @@ TEST_F(SessionTest, DfsphRunsLiveWithItsSolvesInTheStatsAndWaterRunsOut) {
             water);
 }
 
+// Free ice under DFSPH in the live service: the default scene (coarse) runs with its three free bodies,
+// the stats carry the solves, and the dryer is steered in place as under WCSPH.
+TEST_F(SessionTest, DfsphRunsTheDefaultSceneWithItsFreeIceLive) {
+  auto s = make("default", {"spacing=0.006", "solver.pressure=dfsph"});
+  s->start();
+  const auto stats = wait_for_stats(
+      *s, [](const Json& j) { return j.contains("dfsph") && j["steps"].get<std::uint64_t>() >= 20; }, 120s);
+  ASSERT_TRUE(stats->contains("dfsph")) << stats->dump();
+  EXPECT_FALSE(stats->contains("error")) << stats->dump();
+  EXPECT_EQ((*stats)["dfsph"]["unconverged_density_steps"].get<int>(), 0);
+  const Reply r = call(*s, protocol::ParamSet{"dryers[0].speed", 31.5});
+  ASSERT_TRUE(r.answered);
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_EQ(r.result["applied"], "in place");
+  EXPECT_EQ(s->scene()->dryers.at(0).speed, 31.5);
+}
+
 TEST_F(SessionTest, BlowUpPausesAndReportsWithoutCrashing) {
   // A block thrown down at 1 m/s under a speed limit of 1.02 m/s: gravity breaks the limit within
   // a few milliseconds of simulated time.
