@@ -15,19 +15,6 @@ namespace {
 constexpr int kColumns = 5;  // FM, KR, AD, AV, ERR (sim/kernels/dfsph.cl)
 }
 
-double lattice_sum(KernelFunction kernel, double spacing, double support) {
-  const int reach = static_cast<int>(std::ceil(support / spacing));
-  double sum = 0;
-  for (int x = -reach; x <= reach; ++x)
-    for (int y = -reach; y <= reach; ++y)
-      for (int z = -reach; z <= reach; ++z) {
-        const auto r = static_cast<float>(spacing * std::sqrt(double(x * x + y * y + z * z)));
-        const auto H = static_cast<float>(support);
-        sum += kernel == KernelFunction::WendlandC2 ? sph::wendland_c2_w(r, H) : sph::cubic_spline_w(r, H);
-      }
-  return sum * spacing * spacing * spacing;
-}
-
 DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
                        const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
                        const cl::Buffer& flow)
@@ -41,7 +28,9 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   relaxation << build_options << " -DTHAW_OMEGA=" << scene.solver.pressure_relaxation << "f";
   extrapolate_ = scene.solver.boundary_pressure == DfsphBoundary::Adami2012;
   if (extrapolate_) relaxation << " -DTHAW_DFSPH_EXTRAPOLATE";
-  relaxation << " -DTHAW_DFSPH_LATTICE=" << lattice_sum(scene.solver.kernel, scene.spacing, k.support) << "f";
+  // The density solve's target: the density a resting lattice sums to (dfsph.cl, dfsph_error).
+  const auto w = scene.solver.kernel == KernelFunction::WendlandC2 ? sph::wendland_c2_w : sph::cubic_spline_w;
+  relaxation << " -DTHAW_DFSPH_LATTICE=" << sph::lattice_sum(w, scene.spacing, k.support) << "f";
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph.cl"},
                                 relaxation.str());
   k_columns_ = cl::Kernel(program, "dfsph_columns");

@@ -20,11 +20,6 @@ namespace thaw {
 
 struct SolverConstants;
 
-// Sum_j dx^3 W(x_j) over a cubic lattice of `spacing` around one of its points: the density a resting
-// lattice of water sums to, as a fraction of its rest density (1.003 for Wendland C2 over 3 spacings,
-// 0.99997 for the cubic spline over 2).
-double lattice_sum(KernelFunction kernel, double spacing, double support);
-
 // One solve of one step: iterations done, the mean error when it stopped (density: mean (rho* - rho0) /
 // rho0; divergence: mean (D rho / Dt) dt / rho0) and whether that met the tolerance.
 struct PressureSolve {

@@ -301,6 +301,9 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   if (fluid_ && scene_.solver.pressure == PressureSolver::Dfsph)
     dfsph_ = std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow());
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
+  forces_velocity_ = rigid_ && dfsph_
+                         ? cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, layout_.capacity * sizeof(cl_float4))
+                         : cl::Buffer();
   if (plan.build)
     heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
   store_.allocate(layout_.capacity);
@@ -610,12 +613,8 @@ void Solver::step_dfsph() {
     // Rigid ice's reaction to the viscous pair terms must see the velocities the water's side was
     // computed from, or momentum is not exchanged exactly (measured: 1e-3 of the ice's momentum lost over
     // 300 steps, RigidIceTest.IceAndWaterKeepTheirTotalMomentumUnderDfsph); the solves change them first.
-    if (rigid_ && n_ > 0) {
-      const std::size_t bytes = n_ * sizeof(cl_float4);
-      if (!forces_velocity_() || forces_velocity_.getInfo<CL_MEM_SIZE>() < bytes)
-        forces_velocity_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, layout_.capacity * sizeof(cl_float4));
-      cl_.queue().enqueueCopyBuffer(store_[f_.velocity], forces_velocity_, 0, 0, bytes);
-    }
+    if (rigid_ && n_ > 0)
+      cl_.queue().enqueueCopyBuffer(store_[f_.velocity], forces_velocity_, 0, 0, n_ * sizeof(cl_float4));
   });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });

@@ -182,13 +182,13 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
   const float rho = density[i];
   float err, k;
   if (density_mode) {
-    /* The density a resting lattice of this water sums to (THAW_DFSPH_LATTICE, sim/dfsph_stage.h), so
-     * that water sampled on the scene's lattice starts at rest with its own volume per particle. Against
-     * rho0 itself, Wendland C2 over 3 spacings (lattice sum 1.003) made the density solve expand all
-     * water by 0.3 % in its first step: 70 mm of warm water in ice-bunny rose at 0.17 m/s on average,
-     * and after 0.1 s its top 5 spacings were still under-dense (717-881 kg/m^3; now 895 in the top one,
-     * then 1002-1003), and Iwasaki's neighbour count gave the air 6,875 exposed faces of water (now 994;
-     * WCSPH 963), so the water lost 8x the heat to the air that WCSPH's did. */
+    /* The density a resting lattice of this water sums to (THAW_DFSPH_LATTICE, from sph::lattice_sum in
+     * sph_kernel.h), so water sampled on the scene's lattice starts at rest, one lattice volume per
+     * particle. Against rho0 itself, Wendland C2 over 3 spacings (lattice sum 1.003) made the density
+     * solve expand all water by 0.3 % in its first step: 70 mm of warm water in ice-bunny rose at
+     * 0.17 m/s on average, and after 0.1 s its top 5 spacings were still under-dense (717-881 kg/m^3;
+     * now 895 in the top one, then 1002-1003), and Iwasaki's neighbour count gave the air 6,875 exposed
+     * faces of water (now 994; WCSPH 963), so the water lost 8x the heat to the air that WCSPH's did. */
     const float rho0 = flow[material[i]].rest_density * THAW_DFSPH_LATTICE;
     err = fmax(rho + dt * rate - rho0, 0.0f);
     k = err * fmax(col[COL_AD * stride + i], 0.0f) / (dt * dt); /* a boundary's flag, if it melted: 0 */

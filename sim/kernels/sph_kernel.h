@@ -54,6 +54,20 @@ THAW_FN float wendland_c2_grad_factor(float r, float H) {
 }
 
 #ifndef __OPENCL_VERSION__
+/* Host only: sum_j dx^3 W(|x_j|) over a simple cubic lattice of `spacing` around one of its points, the
+ * density a resting lattice of fluid sums to as a fraction of its rest density (the cubic spline at
+ * H = 2 dx: 0.99997; Wendland C2: 1.0338 at 2 dx, 1.0031 at 3 dx; tests/sim/sph_kernel_test.cpp). DFSPH's
+ * density solve aims at it (sim/dfsph_stage.cpp). */
+inline double lattice_sum(float (*w)(float, float), double spacing, double support) {
+  const auto H = static_cast<float>(support);
+  const int m = static_cast<int>(std::ceil(support / spacing)) + 1;
+  double sum = 0;
+  for (int i = -m; i <= m; ++i)
+    for (int j = -m; j <= m; ++j)
+      for (int l = -m; l <= m; ++l)
+        sum += w(static_cast<float>(spacing * std::sqrt(double(i * i + j * j + l * l))), H);
+  return sum * spacing * spacing * spacing;
+}
 }  // namespace thaw::sph
 #endif
 #endif

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/dfsph_stage.h"
 #include "sim/error.h"
+#include "sim/kernels/sph_kernel.h"
 #include "sim/metrics.h"
 #include "sim/solver.h"
 #include "sim/state_file.h"
@@ -93,8 +93,8 @@ TEST_F(DfsphTest, StillWaterHoldsItsDensityAtAFiveTimesLongerStep) {
 // lattice sums to (1.003 rho0 for Wendland C2 over 3 spacings), not at rho0, which made it expand all the
 // water by 0.3 % in its first step (ice-bunny's water rose at 0.17 m/s on average).
 TEST_F(DfsphTest, WaterOnTheLatticeStartsAtRestWithWendland) {
-  EXPECT_NEAR(lattice_sum(KernelFunction::WendlandC2, 0.01, 0.03), 1.003, 5e-4);
-  EXPECT_NEAR(lattice_sum(KernelFunction::CubicSpline, 0.01, 0.02), 1.0, 1e-4);
+  EXPECT_NEAR(sph::lattice_sum(sph::wendland_c2_w, 0.01, 0.03), 1.003, 5e-4);
+  EXPECT_NEAR(sph::lattice_sum(sph::cubic_spline_w, 0.01, 0.02), 1.0, 1e-4);
   const Scene s = tank({"solver.pressure=dfsph", "solver.kernel=wendland_c2", "solver.support_ratio=3"});
   Solver d(cl(), s, initial_state(s));
   for (int i = 0; i < 5; ++i) d.step();

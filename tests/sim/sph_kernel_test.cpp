@@ -144,17 +144,9 @@ TEST_P(SphKernel, GradientMatchesFiniteDifference) {
 }
 
 // Summation density of a perfect cubic lattice of spacing dx, kernel support H = ratio dx.
+// The lattice sum (sph_kernel.h) with the support given as a ratio of the spacing.
 double lattice_sum(float (*w)(float, float), float dx, float ratio) {
-  const float H = ratio * dx;
-  const int m = static_cast<int>(std::ceil(ratio)) + 1;
-  double sum = 0;
-  for (int i = -m; i <= m; ++i)
-    for (int j = -m; j <= m; ++j)
-      for (int l = -m; l <= m; ++l) {
-        const double r = dx * std::sqrt(double(i * i + j * j + l * l));
-        sum += double(dx) * dx * dx * w(static_cast<float>(r), H);
-      }
-  return sum;
+  return sph::lattice_sum(w, dx, ratio * dx);
 }
 
 // The default support ratio (solver.support_ratio = 2) with either kernel: a lattice at rest must
