@@ -20,8 +20,9 @@ namespace thaw {
 
 struct SolverConstants;
 
-// One solve of one step: iterations done, the mean error when it stopped (density: mean (rho* - rho0) /
-// rho0; divergence: mean (D rho / Dt) dt / rho0) and whether that met the tolerance.
+// One solve of one step: iterations done, the mean error last measured (density: mean (rho* - rho0) /
+// rho0; divergence: mean (D rho / Dt) dt / rho0; measured before the last correction where the solve
+// stopped after the two it always makes) and whether that met the tolerance.
 struct PressureSolve {
   int iterations = 0;
   double error = 0;
@@ -42,8 +43,11 @@ class DfsphStage {
              const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
              const cl::Buffer& flow);
 
-  // After the density pass: who is fluid, and alpha for both solves.
-  void prepare(const NeighbourView& nv);
+  // After the grid's sort, before the density pass: who is fluid (the density pass then computes alpha for
+  // both solves into columns(): FluidStage::compute_dfsph_alpha).
+  void mark_fluid();
+  const cl::Buffer& columns() const { return col_; }
+  cl_uint min_neighbours() const { return min_neighbours_; }
   // Makes the velocities divergence-free with the step that produced them (dt: the last step's; none
   // before the first step).
   PressureSolve divergence_solve(const NeighbourView& nv, double dt);
@@ -76,7 +80,7 @@ class DfsphStage {
   double rest_density_ = 1000;
   double density_tolerance_ = 0, divergence_tolerance_ = 0;
   int max_iterations_ = 100;
-  cl::Kernel k_columns_, k_alpha_, k_error_, k_warm_, k_correct_, k_sum_, k_predict_, k_drift_, k_pressure_,
+  cl::Kernel k_columns_, k_error_, k_warm_, k_correct_, k_sum_, k_predict_, k_drift_, k_pressure_,
       k_extrapolate_;
   cl_float4 gravity_{};
   bool extrapolate_ = true;  // solver.boundary_pressure adami2012; akinci2012 leaves the boundary's kappa 0

@@ -62,7 +62,7 @@ FluidStage::FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
     all.insert(all.end(), files);
     return all;
   };
-  k_density_ = cl::Kernel(cl.build(with({"density.cl"}), build_options), "density");
+  k_density_ = cl::Kernel(cl.build(with({"dfsph_columns.h", "density.cl"}), build_options), "density");
   k_forces_ = cl::Kernel(cl.build(with({"forces.cl"}), build_options), "forces");
   const auto integrate = cl.build(with({"integrate.cl", "step_limits.cl"}), build_options);
   k_limits_ = cl::Kernel(integrate, "step_limits");
@@ -107,6 +107,10 @@ void FluidStage::density(const NeighbourView& nv) {
   density_params_.n = static_cast<cl_uint>(layout_.n);
   set_args(k_density_, store_[f_.position], nv.soa, store_[f_.phase], store_[f_.material], flow_,
            nv.cell_start, nv.grid, density_params_, store_[f_.density], state_, derived_);
+  if (dfsph_columns_) {  // built with THAW_DFSPH: the pass also computes alpha (density.cl)
+    k_density_.setArg(11, *dfsph_columns_);
+    k_density_.setArg(12, dfsph_min_neighbours_);
+  }
   launch(cl_.queue(), k_density_, layout_.n);
 }
 

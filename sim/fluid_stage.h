@@ -44,6 +44,12 @@ class FluidStage {
              const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout);
 
   void density(const NeighbourView& nv);
+  // Under DFSPH the density pass also writes the solver's alpha columns (sim/kernels/density.cl): the
+  // solver's column buffer, owned by the DFSPH stage, which the solver builds and drops with this one.
+  void compute_dfsph_alpha(const cl::Buffer& columns, cl_uint min_neighbours) {
+    dfsph_columns_ = &columns;
+    dfsph_min_neighbours_ = min_neighbours;
+  }
   void forces(const NeighbourView& nv);
   FlowLimits limits();
   // Symplectic Euler over dt, velocities scaled by damping_factor (1: none).
@@ -63,6 +69,8 @@ class FluidStage {
   fluid::ForcesParams forces_params_{};
   cl::Kernel k_density_, k_forces_, k_limits_, k_integrate_;
   cl::Buffer flow_, state_, accel_, derived_, limits_f_, limits_i_;
+  const cl::Buffer* dfsph_columns_ = nullptr;
+  cl_uint dfsph_min_neighbours_ = 0;
 };
 
 }  // namespace thaw

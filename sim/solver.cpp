@@ -300,6 +300,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   if (scene_.solver.flow) fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_);
   if (fluid_ && scene_.solver.pressure == PressureSolver::Dfsph)
     dfsph_ = std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow());
+  if (dfsph_) fluid_->compute_dfsph_alpha(dfsph_->columns(), dfsph_->min_neighbours());
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
   forces_velocity_ = rigid_ && dfsph_
                          ? cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, layout_.capacity * sizeof(cl_float4))
@@ -453,6 +454,7 @@ void Solver::compute_boundary_psi(const std::string& opts) {
 }
 
 void Solver::compute_density() {
+  if (dfsph_) dfsph_->mark_fluid();  // the density pass reads it for DFSPH's alpha
   if (fluid_) fluid_->density(neighbours());
 }
 
@@ -603,10 +605,7 @@ void Solver::step() {
 void Solver::step_dfsph() {
   timed(Stage::Grid, [&] { build_grid(); });
   if (rigid_) timed(Stage::Bodies, [&] { rigid_->relabel_if_due(buffers(), steps_); });
-  timed(Stage::Density, [&] {
-    compute_density();
-    dfsph_->prepare(neighbours());
-  });
+  timed(Stage::Density, [&] { compute_density(); });  // with alpha for both solves
   timed(Stage::Pressure, [&] { dfsph_->divergence_solve(neighbours(), dt_); });
   timed(Stage::Forces, [&] {
     compute_forces();

@@ -9,7 +9,12 @@
 kernel void density(global const float4* pos, global const float* soa, global const uchar* phase,
                     global const uchar* material, global const MaterialFlow* flow, global const uint* cell_start,
                     const Grid g, const DensityParams P, global float* density, global float4* state,
-                    global float* derived) {
+                    global float* derived
+#ifdef THAW_DFSPH
+                    ,
+                    global float* col, const uint min_neighbours
+#endif
+) {
   const uint i = get_global_id(0);
   const uint n = P.n, stride = P.stride;
   if (i >= n) return;
@@ -25,7 +30,16 @@ kernel void density(global const float4* pos, global const float* soa, global co
   global const float* Y = soa + stride;
   global const float* Z = soa + 2 * stride;
   global const float* M = soa + 3 * stride;
+  const int boundary = THAW_IS_STATIC(phase[i]);
   floatV acc = (floatV)(0.0f);
+#ifdef THAW_DFSPH
+  /* DFSPH's alpha (dfsph.cl) in the same visit: G = sum_j m_j grad W_ij over every neighbour, S = m_i
+   * sum_j (fluid) m_j |grad W_ij|^2, the neighbour count; a boundary particle only learns whether fluid is
+   * within reach (the fluid masses FM, written by dfsph_columns before this pass). */
+  global const float* FM = col + COL_FM * stride;
+  floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
+  floatV count = (floatV)(0.0f);
+#endif
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       const floatV dx = pi.x - vloadV(0, X + j);
@@ -34,11 +48,45 @@ kernel void density(global const float4* pos, global const float* soa, global co
       const floatV r2 = dx * dx + dy * dy + dz * dz;
       /* Lanes past the row's end, or outside the support, add nothing (a select, not a branch). */
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-      const floatV w = vloadV(0, M + j) * w_shape(sqrt(r2) * inv_H);
-      acc += select((floatV)(0.0f), w, in);
+      const floatV m = vloadV(0, M + j);
+      const floatV q = sqrt(r2) * inv_H;
+      acc += select((floatV)(0.0f), m * w_shape(q), in);
+#ifdef THAW_DFSPH
+      const floatV fm = vloadV(0, FM + j);
+      if (boundary) {
+        count += select((floatV)(0.0f), fm, in);
+      } else {
+        const floatV gf = grad_shape(q); /* grad W = sigma/H^2 gf x_ij; the factor comes last */
+        const floatV mg = m * gf;
+        gx += select((floatV)(0.0f), mg * dx, in);
+        gy += select((floatV)(0.0f), mg * dy, in);
+        gz += select((floatV)(0.0f), mg * dz, in);
+        s += select((floatV)(0.0f), fm * gf * gf * r2, in);
+        count += select((floatV)(0.0f), (floatV)(1.0f), in);
+      }
+#endif
     }
   }
   const float rho = THAW_SIGMA(H) * lanes_sum(acc);
+#ifdef THAW_DFSPH
+  /* alpha_i = rho_i / (|G_i|^2 + S_i) for both solves (Bender & Koschier 2015 eq 10; dfsph.cl has the
+   * columns). A boundary particle's AD is -1 when fluid is within its support (the solves extrapolate a
+   * pressure to it), else 0. */
+  col[COL_ERR * stride + i] = 0.0f;
+  if (boundary) {
+    col[COL_AD * stride + i] = lanes_sum(count) > 0.0f ? -1.0f : 0.0f;
+    col[COL_AV * stride + i] = 0.0f;
+  } else {
+    const float scale = THAW_SIGMA(H) * inv_H * inv_H;
+    const float3 G = scale * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
+    const float S = pi.w * scale * scale * lanes_sum(s);
+    const float d = dot(G, G) + S;
+    /* A particle without neighbours (d = 0) cannot be corrected by its own pressure: leave it alone. */
+    const float alpha = d > 0.0f ? rho / d : 0.0f;
+    col[COL_AD * stride + i] = alpha;
+    col[COL_AV * stride + i] = lanes_sum(count) - 1.0f >= (float)min_neighbours ? alpha : 0.0f; /* -1: itself */
+  }
+#endif
 #ifdef THAW_DFSPH
   /* DFSPH (sim/kernels/dfsph.cl) solves for the pressure after the forces pass: none here. */
   float p = 0.0f;
@@ -57,7 +105,6 @@ kernel void density(global const float4* pos, global const float* soa, global co
 #endif
   /* No tension: clamping keeps free-surface particles from clumping (tensile instability). */
   p = fmax(p, 0.0f);
-  const int boundary = THAW_IS_STATIC(phase[i]);
   const float dp = p / (rho * rho);
   density[i] = rho;
   state[i] = (float4)(rho, dp, boundary ? 1.0f : 0.0f, p);

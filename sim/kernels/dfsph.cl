@@ -25,7 +25,9 @@
  * pulled together. The divergence solve leaves particles with fewer than min_neighbours neighbours alone
  * (their density deficit is the surface's, not a flow's), as SPlisHSPlasH's implementation does.
  *
- * Per-particle columns (blocks of `stride` floats in `col`, read on SIMD lanes like the reorder's soa):
+ * α is computed in the density pass's visit (density.cl, built with THAW_DFSPH), which saves a sweep.
+ * Per-particle columns (blocks of `stride` floats in `col`, dfsph_columns.h; read on SIMD lanes like the
+ * reorder's soa):
  *   FM    m_j for fluid particles, 0 for boundary ones
  *   KR    κ_j / ρ_j of the current iteration (boundary particles: extrapolated, dfsph_extrapolate)
  *   AD    α_j for the density solve, AV α_j for the divergence solve (0 where it is not solved); for a
@@ -58,11 +60,6 @@
 #define THAW_DFSPH_LATTICE 1.0f
 #endif
 
-#define COL_FM 0
-#define COL_KR 1
-#define COL_AD 2
-#define COL_AV 3
-#define COL_ERR 4
 
 /* The reorder's structure-of-arrays copy: positions and masses, blocks of `stride` floats. */
 #define DFSPH_SOA(soa, stride)                  \
@@ -81,68 +78,14 @@
   const floatV r2 = dx * dx + dy * dy + dz * dz;                        \
   const intV in = (THAW_LANE_IDS < (int)((je) - (j))) & (r2 < (H2));
 
-/* FM: who is fluid, as the lanes of the other passes read it. */
+/* FM: who is fluid, as the lanes of the other passes (and the density pass's alpha) read it; run after the
+ * grid's sort, before the density pass. */
 kernel void dfsph_columns(global const float4* pos, global const uchar* phase, global float* col, const uint stride,
                           const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   col[COL_FM * stride + i] = THAW_IS_STATIC(phase[i]) ? 0.0f : pos[i].w;
   col[COL_KR * stride + i] = 0.0f;
-}
-
-/* α_i for both solves, from the densities of the density pass. */
-kernel void dfsph_alpha(global const float4* pos, global const float* soa, global const float* density,
-                        global const uchar* phase, global float* col, global const uint* cell_start, const Grid g,
-                        const float H, const uint min_neighbours, const uint stride, const uint n) {
-  const uint i = get_global_id(0);
-  if (i >= n) return;
-  const float4 pi = pos[i];
-  const int4 c = grid_cell(g, pi);
-  const float H2 = H * H, inv_H = 1.0f / H;
-  DFSPH_SOA(soa, stride)
-  global const float* FM = col + COL_FM * stride;
-  col[COL_ERR * stride + i] = 0.0f;
-  if (THAW_IS_STATIC(phase[i])) {
-    col[COL_AV * stride + i] = 0.0f;
-#ifdef THAW_DFSPH_EXTRAPOLATE
-    /* A boundary particle only needs to know whether fluid is within reach (the extrapolation takes a
-     * pressure from it): the fluid masses within the support, without the kernel. */
-    floatV fluid = (floatV)(0.0f);
-    FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
-      for (uint j = jb; j < je; j += THAW_VW) {
-        DFSPH_LANES(pi, j, je, H2)
-        fluid += select((floatV)(0.0f), vloadV(0, FM + j), in);
-      }
-    }
-    col[COL_AD * stride + i] = lanes_sum(fluid) > 0.0f ? -1.0f : 0.0f;
-#else
-    col[COL_AD * stride + i] = 0.0f; /* one-sided (akinci2012): nothing is extrapolated, no visit needed */
-#endif
-    return;
-  }
-  floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
-  floatV count = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
-    for (uint j = jb; j < je; j += THAW_VW) {
-      DFSPH_LANES(pi, j, je, H2)
-      const floatV gf = grad_shape(sqrt(r2) * inv_H); /* ∇W = sigma/H² gf x_ij; the factor comes last */
-      const floatV mg = vloadV(0, M + j) * gf;
-      gx += select((floatV)(0.0f), mg * dx, in);
-      gy += select((floatV)(0.0f), mg * dy, in);
-      gz += select((floatV)(0.0f), mg * dz, in);
-      s += select((floatV)(0.0f), vloadV(0, FM + j) * gf * gf * r2, in);
-      count += select((floatV)(0.0f), (floatV)(1.0f), in);
-    }
-  }
-  const float scale = THAW_SIGMA(H) * inv_H * inv_H;
-  const float3 G = scale * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
-  const float S = pi.w * scale * scale * lanes_sum(s);
-  const float d = dot(G, G) + S;
-  /* A particle without neighbours (d = 0) cannot be corrected by its own pressure: leave it alone. */
-  const float alpha = d > 0.0f ? density[i] / d : 0.0f;
-  const float neighbours = lanes_sum(count);
-  col[COL_AD * stride + i] = alpha;
-  col[COL_AV * stride + i] = neighbours - 1.0f >= (float)min_neighbours ? alpha : 0.0f; /* -1: itself */
 }
 
 /* Σ_j m_j (v_i - v_j)·∇W_ij over every neighbour (boundary particles move with their body or not at all). */
@@ -175,7 +118,7 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
                         const float dt, const int density_mode, const uint stride, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
-  if (THAW_IS_STATIC(phase[i])) return; /* their KR and ERR stay 0 (dfsph_columns, dfsph_alpha) */
+  if (THAW_IS_STATIC(phase[i])) return; /* their KR and ERR stay 0 (dfsph_columns, density.cl) */
   const float4 pi = pos[i];
   const float3 vi = (float3)(soa[4 * stride + i], soa[5 * stride + i], soa[6 * stride + i]);
   const float rate = density_rate(pi, vi, soa, cell_start, g, H, stride);
@@ -220,7 +163,7 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
                               const float rest_density, const uint stride, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
-  if (!THAW_IS_STATIC(phase[i]) || col[COL_AD * stride + i] >= 0.0f) return; /* flagged -1 by dfsph_alpha */
+  if (!THAW_IS_STATIC(phase[i]) || col[COL_AD * stride + i] >= 0.0f) return; /* flagged -1 by density.cl */
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;

@@ -66,7 +66,7 @@ TEST_F(KernelBuild, EveryEmbeddedStageBuilds) {
        {"grid.cl", "boundary.cl", "density.cl", "forces.cl", "integrate.cl", "step_limits.cl", "heat.cl", "dfsph.cl"})
     EXPECT_NO_THROW(
         cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h", "dryer_model.h",
-                    "heat_params.h", "fluid_params.h", stage},
+                    "heat_params.h", "fluid_params.h", "dfsph_columns.h", stage},
                    "-DKERNEL_W=cubic_spline_w -DKERNEL_GRAD=cubic_spline_grad_factor -DTHAW_EOS_TAIT"))
         << stage;
 }
