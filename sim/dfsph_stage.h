@@ -1,8 +1,9 @@
 #pragma once
 // Divergence-free SPH (Bender & Koschier 2015, 2017): the pressure solver of `solver.pressure: "dfsph"`.
 // The fluid stage's density pass (without an equation of state) and forces pass (viscosity, gravity, the
-// walls' push) stay; this stage replaces the pressure force by two Jacobi solves on the velocities, each
-// warm-started from the last step and stopped at its tolerance or the iteration cap
+// walls' push) stay, the density pass computing alpha too; this stage replaces the pressure force by two
+// Jacobi solves on the velocities, the density solve warm-started from the last step (the divergence solve
+// from zero unless solver.divergence_warm_start), each stopped at its tolerance or the iteration cap
 // (sim/kernels/dfsph.cl has the equations). The step (Solver::step, 2017 Algorithm 1):
 //   grid, densities, alpha -> divergence solve (last step's dt) -> non-pressure forces -> dt from the
 //   velocity CFL -> v += dt a -> density solve -> x += dt v.
@@ -83,6 +84,7 @@ class DfsphStage {
   cl::Kernel k_columns_, k_error_, k_warm_, k_correct_, k_sum_, k_predict_, k_drift_, k_pressure_,
       k_extrapolate_;
   cl_float4 gravity_{};
+  bool divergence_warm_start_ = false;  // solver.divergence_warm_start
   bool extrapolate_ = true;  // solver.boundary_pressure adami2012; akinci2012 leaves the boundary's kappa 0
   cl::Buffer col_, sums_;
   PressureSolve last_density_, last_divergence_;

@@ -712,6 +712,7 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.divergence_tolerance = j["divergence_tolerance"].get<double>();
   s.max_pressure_iterations = j["max_pressure_iterations"].get<int>();
   s.pressure_relaxation = j["pressure_relaxation"].get<double>();
+  s.divergence_warm_start = j["divergence_warm_start"].get<bool>();
   s.boundary_pressure =
       choice_of<DfsphBoundary>(j["boundary_pressure"], {DfsphBoundary::Adami2012, DfsphBoundary::Akinci2012});
   s.eos = choice_of<Eos>(j["eos"], {Eos::Tait, Eos::Linear});

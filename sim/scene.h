@@ -144,6 +144,7 @@ struct SolverSettings {
   double divergence_tolerance = 0.001;  // dfsph: mean (D rho / Dt) dt / rho0 the divergence solve stops at
   int max_pressure_iterations = 100;    // dfsph: per solve and step
   double pressure_relaxation = 0.5;     // dfsph: the relaxed Jacobi's omega (sim/kernels/dfsph.cl)
+  bool divergence_warm_start = false;   // dfsph: the divergence solve starts from last step's kappa
   DfsphBoundary boundary_pressure = DfsphBoundary::Adami2012;  // dfsph: extrapolated, or none (one-sided)
   Eos eos = Eos::Tait;
   double gamma = 7.0;                  // Tait exponent

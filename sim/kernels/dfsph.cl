@@ -39,14 +39,6 @@
  * and the saved field `kappa` (sim/dfsph_stage.cpp): the step's accumulated (Σ κ dt², Σ κ dt) of the two
  * solves, dt-free, which warm-start the next step (2017 §4.3) and make a resumed run bitwise the same. */
 
-/* The share of last step's κ the warm start applies. All of it ratchets: the solves only add (they correct
- * compression, never expansion), so a warm start that overshoots is never taken back, and the hydrostatic
- * tank's kinetic energy grew tenfold every 10 ms until it blew up. Half, as SPlisHSPlasH's implementation
- * does, decays what is no longer needed geometrically. */
-#ifndef THAW_WARM
-#define THAW_WARM 0.5f
-#endif
-
 /* Relaxed Jacobi (solver.pressure_relaxation, as IISPH's omega = 0.5, Ihmsen et al. 2014): each sweep
  * applies omega of the kappa that would zero a particle's own error. Unrelaxed (omega = 1), neighbours
  * that all correct the same compression at once overshoot; the kicks left the water under-dense at its
@@ -187,11 +179,12 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
   col[COL_KR * stride + i] = d > 0.0f ? fmax(lanes_sum(num) / d, 0.0f) / (rest_density * rest_density) : 0.0f;
 }
 
-/* The warm start (2017 §4.3): last step's accumulated κ of this solve as this iteration's KR; the
- * accumulator starts again from zero, and dfsph_correct adds back what it applies. */
+/* The warm start (2017 §4.3): `share` of last step's accumulated κ of this solve as this iteration's KR
+ * (sim/dfsph_stage.cpp says which share and when); the accumulator starts again from zero, and
+ * dfsph_correct adds back what it applies (share 0: nothing is applied, the solve starts from zero). */
 kernel void dfsph_warm(global const float* density, global const uchar* phase, global float* col,
-                       global float2* kappa, const float dt, const int density_mode, const uint stride,
-                       const uint n) {
+                       global float2* kappa, const float dt, const int density_mode, const float share,
+                       const uint stride, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   float2 acc = kappa[i];
@@ -204,7 +197,7 @@ kernel void dfsph_warm(global const float* density, global const uchar* phase, g
     kappa[i] = acc;
     return;
   }
-  const float k = THAW_WARM * (density_mode ? acc.x / (dt * dt) : acc.y / dt);
+  const float k = share * (density_mode ? acc.x / (dt * dt) : acc.y / dt);
   col[COL_KR * stride + i] = k / density[i];
   if (density_mode)
     acc.x = 0.0f;

@@ -112,6 +112,32 @@ TEST_F(DfsphTest, WaterOnTheLatticeStartsAtRestWithWendland) {
   EXPECT_LT(std::abs(rise), 0.05);  // measured 0.0087 m/s; 0.705 when aiming at rho0
 }
 
+// The divergence solve starts from zero by default (its warm start's sweeps cost 14 % of the dam break's
+// wall time for nothing measurable: docs/BENCHMARKS.md); solver.divergence_warm_start puts Bender &
+// Koschier's warm start back. Both hold still water, and the setting is honoured (the runs differ).
+TEST_F(DfsphTest, DivergenceWarmStartIsSelectableAndBothHoldStillWater) {
+  std::map<bool, std::vector<Float4>> positions;
+  for (const bool warm : {false, true}) {
+    const Scene s = tank(
+        {"solver.pressure=dfsph", std::string("solver.divergence_warm_start=") + (warm ? "true" : "false")});
+    ASSERT_EQ(s.solver.divergence_warm_start, warm);
+    Solver d(cl(), s, initial_state(s));
+    while (d.time() < 0.1) d.step();
+    const Metrics m = measure(d);
+    std::printf(
+        "[ info ] divergence warm start %d: %llu steps, %.2f divergence iterations a step, mean density "
+        "error %.3g, max speed %.3g m/s\n",
+        int(warm), static_cast<unsigned long long>(d.steps()),
+        double(d.dfsph()->totals().divergence_iterations) / double(d.dfsph()->totals().steps),
+        m.mean_density_error, m.max_speed);
+    EXPECT_LE(m.mean_density_error, 2 * s.solver.density_tolerance) << warm;
+    EXPECT_LT(m.max_speed, 0.05 * std::sqrt(9.81 * 0.25)) << warm;
+    EXPECT_EQ(d.clamped(), 0u) << warm;
+    positions[warm] = d.particles().position;
+  }
+  EXPECT_NE(positions[false], positions[true]);
+}
+
 // Whole-number settings reach the kernels as valid OpenCL C: "1.00000000f", not "1f", which failed to
 // build (plain Jacobi, solver.pressure_relaxation 1, and a lattice sum of exactly 1).
 TEST_F(DfsphTest, PlainJacobiBuilds) {

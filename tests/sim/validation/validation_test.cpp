@@ -247,9 +247,12 @@ TEST_F(Validation, FloatingWidePrismUnderDfsphFloatsWithinOnePercentOfItsHeight)
 }
 
 // The narrow prism of FloatingNarrowPrismCapsizesOntoItsSide, under DFSPH: it capsizes onto its side too.
+// At 14 particles across the height (2.5 s, 73 s of wall time): 89.74 degrees, 89.76 with the divergence
+// solve warm-started. At 12 the resting angle depends on that choice (89.4 warm-started, 99.6 from zero:
+// it rolls past its side and stays there), at 10 it does not capsize (22-24 degrees) with either.
 TEST_F(Validation, FloatingNarrowPrismCapsizesUnderDfsph) {
   const CaseResult r = run_validation(
-      cl(), "floating", 12,
+      cl(), "floating", 14,
       {"breadth_ratio=0.5", "margin=0.35", "depth=1.1", "run_time=2.5", "solver.pressure=dfsph"});
   print(r);
   EXPECT_TRUE(r.passed());
