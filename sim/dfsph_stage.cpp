@@ -12,7 +12,7 @@
 namespace thaw {
 
 namespace {
-constexpr int kColumns = 5;  // FM, KR, AD, AV, ERR (sim/kernels/dfsph.cl)
+constexpr int kColumns = 5;  // FM, KR, AD, AV, ERR (sim/kernels/dfsph_columns.h)
 // The share of last step's kappa a warm start applies. All of it ratchets: the solves only add (they
 // correct compression, never expansion), so a warm start that overshoots is never taken back, and the
 // hydrostatic tank's kinetic energy grew tenfold every 10 ms until it blew up. Half, as SPlisHSPlasH's

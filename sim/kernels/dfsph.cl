@@ -37,7 +37,8 @@
  *         blew up the first meltwater of ice-on-plate
  *   ERR   this iteration's error: ρ* - ρ0 or Dρ/Dt (≥ 0; 0 for boundary particles)
  * and the saved field `kappa` (sim/dfsph_stage.cpp): the step's accumulated (Σ κ dt², Σ κ dt) of the two
- * solves, dt-free, which warm-start the next step (2017 §4.3) and make a resumed run bitwise the same. */
+ * solves, dt-free, which warm-start the next step's density solve (2017 §4.3; its divergence solve too
+ * with solver.divergence_warm_start) and make a resumed run bitwise the same. */
 
 /* Relaxed Jacobi (solver.pressure_relaxation, as IISPH's omega = 0.5, Ihmsen et al. 2014): each sweep
  * applies omega of the kappa that would zero a particle's own error. Unrelaxed (omega = 1), neighbours
@@ -51,7 +52,6 @@
 #ifndef THAW_DFSPH_LATTICE
 #define THAW_DFSPH_LATTICE 1.0f
 #endif
-
 
 /* The reorder's structure-of-arrays copy: positions and masses, blocks of `stride` floats. */
 #define DFSPH_SOA(soa, stride)                  \
