@@ -20,6 +20,12 @@ constexpr int kColumns = 5;  // FM, KR, AD, AV, ERR (sim/kernels/dfsph_columns.h
 constexpr float kWarmShare = 0.5f;
 }
 
+double dfsph_rest_ratio(const Scene& scene) {
+  const auto w = scene.solver.kernel == KernelFunction::WendlandC2 ? sph::wendland_c2_w : sph::cubic_spline_w;
+  // The support as the solver computes it (SolverConstants::support, a float).
+  return sph::lattice_sum(w, scene.spacing, static_cast<float>(scene.solver.support_ratio * scene.spacing));
+}
+
 DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
                        const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
                        const cl::Buffer& flow)
@@ -35,8 +41,7 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   extrapolate_ = scene.solver.boundary_pressure == DfsphBoundary::Adami2012;
   if (extrapolate_) relaxation << " -DTHAW_DFSPH_EXTRAPOLATE";
   // The density solve's target: the density a resting lattice sums to (dfsph.cl, dfsph_error).
-  const auto w = scene.solver.kernel == KernelFunction::WendlandC2 ? sph::wendland_c2_w : sph::cubic_spline_w;
-  relaxation << " -DTHAW_DFSPH_LATTICE=" << sph::lattice_sum(w, scene.spacing, k.support) << "f";
+  relaxation << " -DTHAW_DFSPH_LATTICE=" << dfsph_rest_ratio(scene) << "f";
   const auto program = cl.build(
       {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph_columns.h", "dfsph.cl"},
       relaxation.str());

@@ -30,6 +30,12 @@ struct PressureSolve {
   bool converged = true;
 };
 
+// The density DFSPH's density solve holds resting water at, as a fraction of rho0: what a resting lattice
+// of the scene's spacing sums to with its kernel (sph::lattice_sum: 1.003 for Wendland C2 over 3 spacings,
+// 0.99997 for the cubic spline over 2). The solve aims at it (dfsph.cl) and the metrics measure
+// compression against it (sim/metrics.cpp).
+double dfsph_rest_ratio(const Scene& scene);
+
 // Counts over a run, for the metrics and the run's warning: steps whose solve stopped at the cap.
 struct PressureSolveTotals {
   std::uint64_t steps = 0, density_iterations = 0, divergence_iterations = 0;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "sim/kernels/sph_kernel.h"
+#include "sim/dfsph_stage.h"
 #include "sim/rigid_ice.h"
 #include "sim/solver.h"
 #include "sim/thermal.h"
@@ -23,13 +23,8 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
   // Compression is measured against the density the pressure solver holds water at rest at: WCSPH's
   // equation of state, rho0; DFSPH's density solve, the density a resting lattice sums to (dfsph.cl: 1.003
   // rho0 for Wendland C2 over 3 spacings), which against rho0 read as 0.3 % of compression in still water.
-  double reference = rest_density;
-  if (scene.solver.pressure == PressureSolver::Dfsph) {
-    const auto w =
-        scene.solver.kernel == KernelFunction::WendlandC2 ? sph::wendland_c2_w : sph::cubic_spline_w;
-    reference *=
-        sph::lattice_sum(w, scene.spacing, static_cast<float>(scene.solver.support_ratio * scene.spacing));
-  }
+  const double reference =
+      scene.solver.pressure == PressureSolver::Dfsph ? rest_density * dfsph_rest_ratio(scene) : rest_density;
   m.min_temperature = std::numeric_limits<double>::infinity();
   m.max_temperature = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < p.size(); ++i) {

@@ -42,10 +42,11 @@ const Field& solver_schema() {
               .def(0.5)
               .above(0)
               .at_most(1),
-          flag("divergence_warm_start",
-               "dfsph: start each divergence solve from half the last step's (Bender & Koschier 2017); false "
-               "starts it from zero, which measured 14 % faster in the dam break with the same front and "
-               "floating draft (docs/BENCHMARKS.md)")
+          flag(
+              "divergence_warm_start",
+              "dfsph: start each divergence solve from half of the last step's divergence pressure (Bender & "
+              "Koschier 2017's warm start); false starts it from zero, which ran the dam break 14 % faster "
+              "with the same front and floating draft (docs/BENCHMARKS.md)")
               .def(false),
           choice(
               "boundary_pressure", {"adami2012", "akinci2012"},
