@@ -123,9 +123,9 @@ int cmd_run(int argc, char** argv) {
 
   const auto counts = solver.particles();
   if (!quiet)
-    std::printf("thaw run: scene '%s', %zu particles (water %zu, ice %zu, solid %zu) on %s\n",
+    std::printf("thaw run: scene '%s', %zu particles (water %zu, ice %zu, solid %zu, air %zu) on %s\n",
                 scene.name.c_str(), solver.size(), counts.count(Phase::Water), counts.count(Phase::Ice),
-                counts.count(Phase::Solid), cl.description().c_str());
+                counts.count(Phase::Solid), counts.count(Phase::Air), cl.description().c_str());
   if (!quiet) {
     const std::vector<std::string> built = solver.stages();
     std::string stages;
@@ -228,6 +228,9 @@ int cmd_run(int argc, char** argv) {
           "closure %.3g J\n",
           m.ice_mass, m.water_mass, m.min_temperature, m.max_temperature, m.mean_temperature, b.heat_in(),
           b.ambient, b.lamps, b.dryers, b.walls, b.held, -b.outflow, b.inflow, m.closure());
+      if (m.count[static_cast<int>(Phase::Air)])
+        std::printf("air: %.6g kg, temperature %.4g..%.4g °C (mean %.4g)\n", m.air_mass,
+                    m.air_min_temperature, m.air_max_temperature, m.air_mean_temperature);
     }
     if (!m.pressure_solve.is_null()) {
       const Json& d = m.pressure_solve;

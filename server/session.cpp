@@ -758,6 +758,9 @@ void Session::publish() {
           std::abs(b.ambient) + std::abs(b.lamps) + std::abs(b.dryers) + std::abs(b.walls) + std::abs(b.held);
       stats["temperature"] = {
           {"min", m.min_temperature}, {"mean", m.mean_temperature}, {"max", m.max_temperature}};
+      if (m.count[static_cast<int>(Phase::Air)])
+        stats["air_temperature"] = {
+            {"min", m.air_min_temperature}, {"mean", m.air_mean_temperature}, {"max", m.air_max_temperature}};
       stats["energy"] = {{"heat_in", b.heat_in()},
                          {"closure", m.closure()},
                          {"closure_relative", m.closure() / std::max({m.enthalpy_scale, gross, 1e-300})}};

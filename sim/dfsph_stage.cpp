@@ -55,8 +55,13 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   k_pressure_ = cl::Kernel(program, "dfsph_pressure");
   k_extrapolate_ = cl::Kernel(program, "dfsph_extrapolate");
   support_ = k.support;
-  gravity_ = {{static_cast<float>(scene.gravity.x()), static_cast<float>(scene.gravity.y()),
-               static_cast<float>(scene.gravity.z()), 0.0f}};
+  // The hydrostatic term of the walls' extrapolated pressure. Air feels no gravity but its buoyancy
+  // (sim/scene.h, Buoyancy), a few per cent of g that is left out here: the walls of a scene of air alone
+  // take the pressure of the air next to them.
+  const bool air_alone =
+      scene.has_air() && scene.fluids.empty() && scene.emitters.empty() && scene.ice.empty();
+  const Eigen::Vector3d g = air_alone ? Eigen::Vector3d::Zero() : scene.gravity;
+  gravity_ = {{static_cast<float>(g.x()), static_cast<float>(g.y()), static_cast<float>(g.z()), 0.0f}};
   // A full neighbourhood holds about (4/3) pi (H / dx)^3 particles; below 60 % of it a particle is at a
   // surface, where the divergence solve leaves it (20 of 33 at H = 2 dx, SPlisHSPlasH's threshold).
   const double full = 4.0 / 3.0 * M_PI * std::pow(double(k.support) / scene.spacing, 3);

@@ -28,8 +28,14 @@ fluid::MaterialFlow flow_row(const SolverSettings& s, float rest_density, float 
 
 // Each material's flow properties, one per Scene::materials (fluid_params.h). Throws SceneError naming
 // the fluid block when the scene has fluids of two rest densities: the passes take them from the table,
-// but the boundaries (Akinci 2012) and the time step still assume one fluid until air lands.
-std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k);
+// but the boundaries (Akinci 2012) and the time step still assume one fluid until the multiphase air
+// model lands. `with_heat`: the heat stage runs, so Boussinesq air reads its temperature (THAW_BUOYANCY);
+// without it the air's buoyancy is the constant of its starting temperature.
+std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k,
+                                                     bool with_heat = false);
+
+// Whether the forces pass reads each particle's temperature: Boussinesq air in a run with heat.
+bool buoyancy_reads_temperature(const Scene& scene, bool with_heat);
 
 // The fastest particle and largest acceleration of the last forces pass, from the per-tile limits.
 struct FlowLimits {
@@ -41,7 +47,10 @@ struct FlowLimits {
 class FluidStage {
  public:
   FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-             const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout);
+             const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
+             bool with_heat);
+  // With buoyancy_reads_temperature(): the enthalpy field the forces pass reads (the heat stage's).
+  void buoyancy_from(ParticleStore::Field enthalpy) { enthalpy_ = enthalpy; }
 
   void density(const NeighbourView& nv);
   // Under DFSPH the density pass also writes the solver's alpha columns (sim/kernels/density.cl): the
@@ -71,6 +80,10 @@ class FluidStage {
   cl::Buffer flow_, state_, accel_, derived_, limits_f_, limits_i_;
   const cl::Buffer* dfsph_columns_ = nullptr;
   cl_uint dfsph_min_neighbours_ = 0;
+  bool buoyancy_ = false;
+  ParticleStore::Field enthalpy_ = 0;
+  bool no_slip_ = false;  // solver.no_slip adami2012: the density pass writes ghost velocities
+  cl::Buffer ghost_;
 };
 
 }  // namespace thaw

@@ -35,6 +35,7 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
   if (plan.dryers) opts += " -DTHAW_DRYERS";
   if (plan.walls) opts += " -DTHAW_WALL_HEAT";
   if (plan.lamps) opts += " -DTHAW_LAMPS";
+  if (plan.adiabatic) opts += " -DTHAW_ADIABATIC";
   for (int a = 0; a < 3; ++a)
     if (scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
@@ -45,6 +46,7 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
   k_heat_ = cl::Kernel(program, "heat");
   k_absorb_ = cl::Kernel(program, "absorb_photons");
   k_budget_ = cl::Kernel(program, "heat_budget");
+  if (plan.adiabatic) k_adiabatic_ = cl::Kernel(program, "adiabatic_state");
 
   auto& ctx = cl.context();
   auto& q = cl.queue();
@@ -176,6 +178,7 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
   P.ambient_temperature = static_cast<float>(scene_.heat.ambient_temperature);
   P.ambient_coefficient = static_cast<float>(scene_.heat.ambient_coefficient);
   P.dt_heat = static_cast<float>(scene_.heat.time_scale * dt);
+  last_dt_heat_ = double(P.dt_heat);
   P.ndryers = static_cast<cl_uint>(scene_.dryers.size());
   P.stride = layout_.stride;
   P.n = n;
@@ -184,6 +187,11 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
   set_args(k_thermal_state_, store_[core_.position], store_[core_.density], store_[enthalpy_],
            store_[core_.phase], store_[core_.material], materials_, thermal_, P);
   launch(q, k_thermal_state_, layout_.n);
+  if (plan_.adiabatic) {
+    set_args(k_adiabatic_, store_[core_.position], store_[core_.phase], store_[core_.material], materials_,
+             nv.soa, thermal_, nv.cell_start, nv.grid, P);
+    launch(q, k_adiabatic_, layout_.n);
+  }
 
   // Without lamps the kernel never touches lamp_energy; any buffer fills the argument.
   const cl::Buffer& lamp_energy = plan_.lamps ? lamp_energy_ : dryers_;
@@ -227,6 +235,22 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
 void HeatStage::warm_up(const NeighbourView& nv, EnergyBudget& budget) {
   if (photons_) photons_->warm_up();
   run(0.0, nv, budget, 0, 0.0, false);
+}
+
+std::vector<double> HeatStage::held_power(const cl::Buffer& material, std::size_t materials) const {
+  std::vector<double> out(materials, 0.0);
+  const std::size_t n = layout_.n;
+  if (n == 0 || last_dt_heat_ <= 0) return out;
+  std::vector<float> e(n);
+  std::vector<std::uint8_t> m(n);
+  auto& q = cl_.queue();
+  // The budget's held block: what the thermostat put back into each particle, i.e. what it gave the rest.
+  q.enqueueReadBuffer(budget_parts_, CL_FALSE, std::size_t(layout_.stride) * 4 * 4, n * 4, e.data());
+  q.enqueueReadBuffer(material, CL_TRUE, 0, n, m.data());
+  for (std::size_t i = 0; i < n; ++i)
+    if (m[i] < materials) out[m[i]] += double(e[i]);
+  for (double& p : out) p /= last_dt_heat_;
+  return out;
 }
 
 void HeatStage::thermal_inputs(std::vector<float>& T, std::vector<float>& k, std::vector<float>& V) const {

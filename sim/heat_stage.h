@@ -56,6 +56,8 @@ class HeatStage {
 
   // T [°C], k [W/m/K] and V [m^3] per particle as the last run's neighbour loop read them.
   void thermal_inputs(std::vector<float>& T, std::vector<float>& k, std::vector<float>& V) const;
+  // The power [W] the held particles of each of `materials` materials gave the rest in the last run().
+  std::vector<double> held_power(const cl::Buffer& material, std::size_t materials) const;
 
  private:
   void upload_dryers();
@@ -66,10 +68,11 @@ class HeatStage {
   const Scene& scene_;
   HeatPlan plan_;
   double diffusion_dt_ = 0, wall_dt_ = 0, exposed_capacity_ = 0;
+  double last_dt_heat_ = 0;  // of the last run() [s]
   float support_ = 0, smoothing_ = 0, rest_density_ = 0;
   const ParticleLayout& layout_;  // the solver's: the particle count changes when water leaves
   ParticleStore::Field enthalpy_ = 0;
-  cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_budget_;
+  cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_budget_, k_adiabatic_;
   cl::Buffer materials_, thermal_, lamp_energy_, hits_, budget_parts_, budget_tiles_, budget_bad_, dryers_,
       phase_changed_;
   bool dryers_dirty_ = true;

@@ -25,8 +25,10 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
   // rho0 for Wendland C2 over 3 spacings), which against rho0 read as 0.3 % of compression in still water.
   const double reference =
       scene.solver.pressure == PressureSolver::Dfsph ? rest_density * dfsph_rest_ratio(scene) : rest_density;
-  m.min_temperature = std::numeric_limits<double>::infinity();
-  m.max_temperature = -std::numeric_limits<double>::infinity();
+  m.min_temperature = m.air_min_temperature = std::numeric_limits<double>::infinity();
+  m.max_temperature = m.air_max_temperature = -std::numeric_limits<double>::infinity();
+  double air_sum = 0;
+  std::size_t air_count = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const auto phase = static_cast<Phase>(p.phase[i]);
     ++m.count[static_cast<int>(phase)];
@@ -43,6 +45,13 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
         m.max_temperature = std::max(m.max_temperature, T);
         t_sum += T;
         ++t_count;
+      } else if (phase == Phase::Air) {
+        m.air_mass += mass;
+        const double T = temperature_at(mt, h);
+        m.air_min_temperature = std::min(m.air_min_temperature, T);
+        m.air_max_temperature = std::max(m.air_max_temperature, T);
+        air_sum += T;
+        ++air_count;
       }
     }
     if (phase == Phase::Solid || phase == Phase::Ice) continue;
@@ -64,6 +73,8 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
   m.mean_density_error = fluid ? err_sum / double(fluid) : 0.0;
   m.mean_temperature = t_count ? t_sum / double(t_count) : 0.0;
   if (!t_count) m.min_temperature = m.max_temperature = 0.0;
+  m.air_mean_temperature = air_count ? air_sum / double(air_count) : 0.0;
+  if (!air_count) m.air_min_temperature = m.air_max_temperature = 0.0;
   if (!m.heat) m.water_mass = m.fluid_mass;
   return m;
 }
@@ -149,6 +160,11 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
     const EnergyBudget& b = m.budget;
     j["mass"] = {{"water", m.water_mass}, {"ice", m.ice_mass}};
     j["temperature"] = {{"min", m.min_temperature}, {"mean", m.mean_temperature}, {"max", m.max_temperature}};
+    if (m.count[static_cast<int>(Phase::Air)]) {
+      j["mass"]["air"] = m.air_mass;
+      j["air_temperature"] = {
+          {"min", m.air_min_temperature}, {"mean", m.air_mean_temperature}, {"max", m.air_max_temperature}};
+    }
     const double gross =
         std::abs(b.ambient) + std::abs(b.lamps) + std::abs(b.dryers) + std::abs(b.walls) + std::abs(b.held);
     j["heat"] = {

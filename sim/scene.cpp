@@ -32,9 +32,12 @@ const char* name(MaterialKind k) {
       return "solid";
     case MaterialKind::Ice:
       return "ice";
+    case MaterialKind::Air:
+      return "air";
   }
   return "?";
 }
+const char* name(Buoyancy b) { return b == Buoyancy::Boussinesq ? "boussinesq" : "none"; }
 const char* name(KernelFunction k) {
   return k == KernelFunction::WendlandC2 ? "wendland_c2" : "cubic_spline";
 }
@@ -43,6 +46,7 @@ const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph"
 const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
 const char* name(ExposedArea) { return "iwasaki2010"; }
 const char* name(DfsphBoundary b) { return b == DfsphBoundary::Akinci2012 ? "akinci2012" : "adami2012"; }
+const char* name(NoSlip n) { return n == NoSlip::Adami2012 ? "adami2012" : "none"; }
 
 namespace {
 // A choice the schema has already checked, as its enum.
@@ -134,6 +138,7 @@ double estimated_particles(const Scene& s, double wall_layers) {
   auto lattice_count = [h](const Box& b) { return ((b.max - b.min) / h).array().floor().prod(); };
   double n = 0.0;
   for (const FluidBlock& f : s.fluids) n += lattice_count(f.box);
+  if (s.has_air()) n += lattice_count(s.air.region);
   for (const IceBlock& f : s.ice)
     n += f.shape.axis_aligned_box() ? lattice_count(f.box) : f.shape.volume() / (h * h * h);
   const double face_area[3] = {extent.y() * extent.z(), extent.x() * extent.z(), extent.x() * extent.y()};
@@ -232,13 +237,14 @@ Box box_of(const Shape& shape) { return {shape.bounds().min(), shape.bounds().ma
 Material material_from_json(const std::string& name, const Json& m) {
   Material mat;
   mat.name = name;
-  mat.kind =
-      choice_of<MaterialKind>(m["kind"], {MaterialKind::Fluid, MaterialKind::Solid, MaterialKind::Ice});
+  mat.kind = choice_of<MaterialKind>(
+      m["kind"], {MaterialKind::Fluid, MaterialKind::Solid, MaterialKind::Ice, MaterialKind::Air});
   mat.density = m["density"].get<double>();
   mat.viscosity = m["viscosity"].get<double>();
   mat.conductivity = m["conductivity"].get<double>();
   mat.specific_heat = m["specific_heat"].get<double>();
   mat.transparent = m.contains("transparent") && m["transparent"].get<bool>();  // solids only
+  mat.adiabatic = m.contains("adiabatic") && m["adiabatic"].get<bool>();        // solids only
   return mat;
 }
 
@@ -284,6 +290,23 @@ FluidBlock fluid_block_from_json(const Json& f, const std::string& path, const S
   check_inside(s.domain, block.box, path + ".box");
   check_start(s, block.material, block.temperature, path + (f.contains("temperature") ? ".temperature" : ""));
   return block;
+}
+
+AirFill air_fill_from_json(const Json& a, const Scene& s, const Json& materials) {
+  AirFill air;
+  air.material = material_index(materials, a["material"], "air.material", "air", "the air fill");
+  air.region = a.contains("region") ? box(a["region"]) : s.domain;
+  if (a.contains("region")) {
+    check_box(air.region, "air.region", "empty box");
+    check_inside(s.domain, air.region, "air.region");
+  }
+  air.temperature = temperature_or(a, s.heat.ambient_temperature);
+  air.buoyancy = choice_of<Buoyancy>(a["buoyancy"], {Buoyancy::None, Buoyancy::Boussinesq});
+  air.reference_temperature =
+      a.contains("reference_temperature") ? a["reference_temperature"].get<double>() : air.temperature;
+  air.expansion =
+      a.contains("expansion") ? a["expansion"].get<double>() : 1.0 / (air.reference_temperature + 273.15);
+  return air;
 }
 
 IceBlock ice_block_from_json(Json& f, const std::string& path, const Scene& s, const Json& materials,
@@ -415,6 +438,10 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     throw SceneError("domain.wall_material", "missing: required because domain.walls is not empty");
   }
   if (s.heat.wall_coefficient > 0) {
+    if (s.wall_material >= 0 && s.materials[static_cast<std::size_t>(s.wall_material)].adiabatic)
+      throw SceneError("domain.wall_heat.coefficient",
+                       "the wall material '" + s.materials[static_cast<std::size_t>(s.wall_material)].name +
+                           "' is adiabatic: no heat crosses it");
     if (s.walls.empty())
       throw SceneError("domain.wall_heat.coefficient", "needs walls: domain.walls is empty");
     Material wall = s.materials[static_cast<std::size_t>(s.wall_material)];
@@ -428,13 +455,18 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     s.fluids.push_back(fluid_block_from_json(doc["fluids"][i], join_path("fluids", i), s, materials));
   for (std::size_t i = 0; i < doc["ice"].size(); ++i)
     s.ice.push_back(ice_block_from_json(doc["ice"][i], join_path("ice", i), s, materials, folder));
-  if (s.fluids.empty() && s.ice.empty() && doc["emitters"].empty())
-    throw SceneError("fluids",
-                     "the scene has neither fluid nor ice nor an emitter: add a block to fluids or ice");
+  if (doc.contains("air")) s.air = air_fill_from_json(doc["air"], s, materials);
+  if (s.fluids.empty() && s.ice.empty() && doc["emitters"].empty() && !s.has_air())
+    throw SceneError(
+        "fluids", "the scene has neither fluid nor ice nor air nor an emitter: add a block to fluids or ice");
 
   for (std::size_t i = 0; i < doc["solids"].size(); ++i) {
     Json& j = doc["solids"][i];
     Solid solid = solid_from_json(j, join_path("solids", i), s, materials, folder);
+    if (j["hold_temperature"].get<bool>() && s.materials[static_cast<std::size_t>(solid.material)].adiabatic)
+      throw SceneError(join_path("solids", i) + ".hold_temperature",
+                       "material '" + s.materials[static_cast<std::size_t>(solid.material)].name +
+                           "' is adiabatic: it passes no heat, so holding its temperature does nothing");
     if (j["hold_temperature"].get<bool>()) {
       Material held = s.materials[static_cast<std::size_t>(solid.material)];
       held.name += " (held at " + format_number(solid.temperature) + " °C)";
@@ -452,6 +484,11 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     s.lamps.push_back(lamp_from_json(doc["lamps"][i], join_path("lamps", i)));
   for (std::size_t i = 0; i < doc["dryers"].size(); ++i)
     s.dryers.push_back(dryer_from_json(doc["dryers"][i], join_path("dryers", i)));
+  if (s.has_air() && !s.dryers.empty())
+    throw SceneError(
+        "dryers[0]",
+        "the cone dryer heats ice and water where no air particles are; with `air` it would heat "
+        "them through the air (counted twice): remove the dryer or the air");
   for (std::size_t i = 0; i < doc["emitters"].size(); ++i) {
     Json e = doc["emitters"][i];
     if (!e.contains("temperature")) e["temperature"] = s.heat.ambient_temperature;
@@ -463,19 +500,35 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   for (int a = 0; a < 3; ++a) {
     if (!s.solver.periodic[static_cast<std::size_t>(a)]) continue;
     const std::string axis(1, kAxis[static_cast<std::size_t>(a)]);
+    if (s.solver.flow && a == 0)
+      throw SceneError(
+          "solver.periodic",
+          "x can be periodic only with solver.flow = false: flowing particles wrap along y and z");
     if (s.solver.flow)
-      throw SceneError("solver.periodic",
-                       "periodic axes need solver.flow = false: moving particles do not wrap");
+      for (std::size_t b = 0; b < s.ice.size(); ++b)
+        if (s.ice[b].motion == IceBlock::Motion::Free)
+          throw SceneError(join_path("ice", b) + ".motion", "free ice cannot move through a periodic axis (" +
+                                                                axis +
+                                                                "): make it fixed, or the axis not periodic");
+    if (s.open_faces & (3u << (2 * a)))
+      throw SceneError("domain.open", "an open side on the periodic axis " + axis);
     for (const std::string& w : s.walls)
       if (w[1] == kAxis[static_cast<std::size_t>(a)])
         throw SceneError("domain.walls", "wall " + w + " on the periodic axis " + axis);
     const double length = s.domain.max[a] - s.domain.min[a];
     const double support = s.solver.support_ratio * s.spacing;
-    if (length < 3.0 * support)
+    if (length < 3.0 * support * (1.0 - 1e-9))
       throw SceneError("solver.periodic", "the domain is " + format_number(length) + " m long along " + axis +
                                               ", less than 3 kernel supports (" +
                                               format_number(3.0 * support) + " m)");
   }
+
+  if (s.solver.no_slip != NoSlip::None)
+    for (std::size_t b = 0; b < s.ice.size(); ++b)
+      if (s.ice[b].motion == IceBlock::Motion::Free)
+        throw SceneError("solver.no_slip", "no-slip walls are not built for free ice yet (" +
+                                               join_path("ice", b) +
+                                               " is free): the body would not take the viscous reaction");
 
   const double n = estimated_particles(s, wall_layer_count(s));
   if (n > kMaxParticles) {
@@ -722,6 +775,7 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.reference_speed = j["reference_speed"].get<double>();
   s.artificial_viscosity = j["artificial_viscosity"].get<double>();
   s.boundary_viscosity = j["boundary_viscosity"].get<double>();
+  s.no_slip = choice_of<NoSlip>(j["no_slip"], {NoSlip::None, NoSlip::Adami2012});
   s.boundary_volume =
       choice_of<BoundaryVolume>(j["boundary_volume"], {BoundaryVolume::Lattice, BoundaryVolume::Akinci2012});
   s.cfl = j["cfl"].get<double>();

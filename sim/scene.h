@@ -25,7 +25,9 @@ struct Box {
 
 // Choices of the scene file as enums at the host boundary; the scene loader maps the file's spellings
 // (name() gives them back for messages and kernel build options).
-enum class MaterialKind { Fluid, Solid, Ice };
+// Air: a fluid of its own phase (Domaradzki & Martyn sec. 6.1): it flows, conducts and carries heat, and
+// never melts, freezes, exchanges heat with the ambient model or shows in the surface view.
+enum class MaterialKind { Fluid, Solid, Ice, Air };
 enum class KernelFunction { CubicSpline, WendlandC2 };
 enum class Eos { Tait, Linear };
 // The pressure solver: weakly compressible (an equation of state), or divergence-free SPH (Bender &
@@ -35,13 +37,16 @@ enum class BoundaryVolume { Lattice, Akinci2012 };
 // DFSPH: the pressure boundary particles take in the solves (sim/kernels/dfsph.cl).
 enum class DfsphBoundary { Adami2012, Akinci2012 };
 enum class ExposedArea { Iwasaki2010 };
-const char* name(MaterialKind k);    // "fluid", "solid", "ice"
+// How walls hold the fluid's tangential velocity: only through boundary_viscosity, or no-slip.
+enum class NoSlip { None, Adami2012 };
+const char* name(MaterialKind k);    // "fluid", "solid", "ice", "air"
 const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
 const char* name(Eos e);             // "tait", "linear"
 const char* name(PressureSolver p);  // "wcsph", "dfsph"
 const char* name(BoundaryVolume b);  // "lattice", "akinci"
 const char* name(ExposedArea a);     // "iwasaki2010" (also the heat pass's function suffix)
 const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
+const char* name(NoSlip n);          // "none", "adami2012"
 
 struct Material {
   std::string name;
@@ -54,11 +59,30 @@ struct Material {
   double melting_point = 0.0;  // T_m [°C] of the same pair
   int partner = -1;            // ice: the fluid it melts into; fluid: the ice it freezes into; -1 none
   bool transparent = false;    // solids: drawn as glass (the renderer's business only)
+  bool adiabatic = false;      // solids: an ideal insulator (heat.cl, adiabatic_state)
   // Variants the scene loader adds (named "<material> (...)"): a solid held at a temperature, and the
   // tank walls when they exchange heat with the outside.
   bool held = false;
   double held_temperature = 0.0;  // [°C]
   bool wall_heat = false;
+};
+
+// How air's density follows its temperature. Boussinesq: the momentum equation keeps the density rho0
+// except in the body force, rho0 g (1 - beta (T - T0)) (de Vahl Davis 1983's problem); the uniform part
+// rho0 g only makes the air's own hydrostatic pressure, a few pascals, and is left out, so the air feels
+// -beta (T - T0) g alone. None: air feels no gravity at all.
+enum class Buoyancy { None, Boussinesq };
+const char* name(Buoyancy b);  // "none", "boussinesq"
+
+// The scene's air particles (`air`): a region filled on the particle lattice with an air material,
+// except where fluid, ice or solids are.
+struct AirFill {
+  int material = -1;  // an air material (index into Scene::materials); -1: the scene has no air particles
+  Box region;         // the domain unless given
+  double temperature = 20.0;  // initial [°C]
+  Buoyancy buoyancy = Buoyancy::Boussinesq;
+  double reference_temperature = 20.0;  // T0 [°C]
+  double expansion = 1.0 / 293.15;      // beta [1/K]; an ideal gas's 1 / (T0 + 273.15) unless given
 };
 
 struct FluidBlock {
@@ -153,10 +177,11 @@ struct SolverSettings {
   double reference_speed = 0.0;        // [m/s]; 0 = sqrt(2 g H) from the tallest fluid block
   double artificial_viscosity = 0.02;  // Monaghan alpha
   double boundary_viscosity = 0.0;     // alpha against static solids (0 = free slip)
+  NoSlip no_slip = NoSlip::None;       // adami2012: no-slip walls with the fluid's viscosity (forces.cl)
   // Lattice: dx^3; Akinci2012: Akinci 2012 eq. 4, 1 / sum_k W_bk.
   BoundaryVolume boundary_volume = BoundaryVolume::Lattice;
   double cfl = 0.4;               // dt <= cfl * h / (c + v_max)
-  double viscous_number = 0.125;  // dt <= viscous_number * h^2 / nu
+  double viscous_number = 0.125;  // dt <= viscous_number * min(h, spacing)^2 / nu
   double force_number = 0.25;     // dt <= force_number * sqrt(h / a_max)
   double max_dt = 1e-3;           // [s] user cap
   double min_dt = 1e-8;           // [s] below this the run stops as blown up
@@ -190,6 +215,8 @@ struct Scene {
   SolverSettings solver;
   std::vector<Material> materials;
   std::vector<FluidBlock> fluids;
+  AirFill air;
+  bool has_air() const { return air.material >= 0; }
   std::vector<IceBlock> ice;
   std::vector<Solid> solids;
   HeatSettings heat;

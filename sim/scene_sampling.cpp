@@ -78,10 +78,17 @@ HostParticles sample_scene(const Scene& scene) {
       for (const Vec3& x : voxelize_shell(s.shape, dx, layers, &scene.domain.min))
         add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
     } else {
-      // Layers behind the plane, clipped to the domain grown by the layer depth.
+      // Layers behind the plane, clipped to the domain grown by the layer depth; along a periodic axis
+      // to one period [min, max), which its neighbours see repeated.
       const Vec3 nrm = s.normal.normalized();
       const Vec3 u = nrm.unitOrthogonal(), v = nrm.cross(u);
       Box grown{scene.domain.min - Vec3::Constant(depth), scene.domain.max + Vec3::Constant(depth)};
+      Box period = grown;
+      for (int a = 0; a < 3; ++a)
+        if (scene.solver.periodic[static_cast<std::size_t>(a)]) {
+          period.min[a] = scene.domain.min[a];
+          period.max[a] = scene.domain.max[a] - 1e-9 * dx;
+        }
       // The plane's (u, v) coordinates, relative to s.point, that cover the grown domain.
       const double umin = -grown.max_along(-u) - s.point.dot(u), umax = grown.max_along(u) - s.point.dot(u);
       const double vmin = -grown.max_along(-v) - s.point.dot(v), vmax = grown.max_along(v) - s.point.dot(v);
@@ -89,7 +96,7 @@ HostParticles sample_scene(const Scene& scene) {
         for (double b = std::floor(vmin / dx) * dx; b <= vmax; b += dx)
           for (int k = 0; k < layers; ++k) {
             const Vec3 x = s.point + (a + 0.5 * dx) * u + (b + 0.5 * dx) * v - (k + 0.5) * dx * nrm;
-            if (inside(grown, x)) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
+            if (inside(period, x)) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
           }
     }
   }
@@ -153,6 +160,20 @@ HostParticles sample_scene(const Scene& scene) {
     for (std::size_t e = 0; e < b; ++e)
       drop_inside(points, Shape::box(scene.fluids[e].box.min, scene.fluids[e].box.max));
     for (const Vec3& x : points) add(p, x, f.velocity, mass, Phase::Water, f.material, h);
+  }
+  // Air: the domain's lattice over its region, skipping points inside solids, ice or fluid blocks.
+  if (scene.has_air()) {
+    const AirFill& a = scene.air;
+    const float mass = static_cast<float>(scene.materials[a.material].density * dx * dx * dx);
+    const double h = enthalpy_at(scene, a.material, a.temperature);
+    std::vector<Vec3> points = voxelize(Shape::box(a.region.min, a.region.max), dx, &scene.domain.min);
+    drop_outside(points, scene.domain);
+    for (const auto& s : scene.solids) drop_inside(points, s);
+    for (const auto& c : scene.ice) drop_inside(points, c.shape);
+    for (const auto& f : scene.fluids) drop_inside(points, Shape::box(f.box.min, f.box.max));
+    if (points.empty())
+      throw SceneError("air", "its region holds no particle outside the solids, ice and fluid blocks");
+    for (const Vec3& x : points) add(p, x, Vec3::Zero(), mass, Phase::Air, a.material, h);
   }
   if (p.size() > std::size_t(0xffffffffu)) throw SceneError("spacing", "too many particles for 32-bit ids");
   return p;

@@ -75,6 +75,12 @@ const Field& solver_schema() {
               .at_least(0)
               .at_most(1)
               .client_settable(),
+          choice("no_slip", {"none", "adami2012"},
+                 "adami2012: walls, solids and ice hold the fluid still at their surface (Adami et al. 2012 "
+                 "eqs 22-23: in the viscous term each boundary particle moves with 2 v_wall minus the fluid "
+                 "velocity around it, with the fluid's own viscosity; boundary_viscosity is then unused); "
+                 "none: walls resist only through boundary_viscosity")
+              .def("none"),
           number("boundary_viscosity", "Monaghan alpha against static solids; 0 = free slip")
               .def(0.0)
               .at_least(0)
@@ -89,7 +95,7 @@ const Field& solver_schema() {
               .above(0)
               .at_most(1)
               .client_settable(),
-          number("viscous_number", "Viscous limit: dt <= viscous_number * h^2 / nu")
+          number("viscous_number", "Viscous limit: dt <= viscous_number * min(h, spacing)^2 / nu")
               .def(0.125)
               .above(0)
               .at_most(1),
@@ -118,9 +124,10 @@ const Field& solver_schema() {
                "only heat "
                "flows, at the diffusion time step (conduction studies, the Stefan problem)")
               .def(true),
-          subset("periodic", {"x", "y", "z"},
-                 "Axes along which the domain wraps around (heat only: needs flow = false, no walls on those "
-                 "axes, and a domain at least 3 kernel supports long along them)")
+          subset(
+              "periodic", {"x", "y", "z"},
+              "Axes along which the domain wraps around (no walls or open sides on those axes, a domain at "
+              "least 3 kernel supports long along them; with flow only y and z, and no free ice)")
               .def(Json::array()),
           number("diffusion_number",
                  "Heat diffusion limit: dt <= diffusion_number * h^2 / (heat.time_scale * alpha_max)")
@@ -334,10 +341,10 @@ const Field& scene_schema() {
               "Still air around the scene (the mode without air particles)."),
           map_of("materials", "<name>",
                  {
-                     choice("kind", {"fluid", "solid", "ice"},
+                     choice("kind", {"fluid", "solid", "ice", "air"},
                             "Fluid particles move; solids are static boundaries; ice is rigid (held where it "
                             "starts with motion fixed, a floating body with motion free) and melts into its "
-                            "melts_into fluid"),
+                            "melts_into fluid; air is a gas that flows and carries heat (the `air` fill)"),
                      number("density",
                             "Rest density; 0.01 is below any real gas (1e-300 gave particles no mass)")
                          .in("kg/m^3")
@@ -352,6 +359,14 @@ const Field& scene_schema() {
                      flag("transparent",
                           "Drawn as glass: clear and slightly tinted, with Fresnel reflection, so what it "
                           "holds shows through (solids; rendering only)")
+                         .def(false)
+                         .when("kind", "solid"),
+                     flag("adiabatic",
+                          "An ideal insulator: no heat crosses its surface, and the fluid or ice beside it "
+                          "conducts along it as in bulk (its particles take the temperature and conductivity "
+                          "of what is around them, the heat that takes booked as `held`); conductivity is "
+                          "then unused. A solid of conductivity 0 insulates too, but the conduction along "
+                          "it runs short of neighbours within a kernel's reach (solids)")
                          .def(false)
                          .when("kind", "solid"),
                      text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
@@ -384,6 +399,38 @@ const Field& scene_schema() {
                    },
                    "Blocks of fluid particles.")
               .def(Json::array()),
+          object(
+              "air",
+              {
+                  text("material", "Name of an air material"),
+                  box_field("region", "Filled with air; default the whole domain").optional(),
+                  number("temperature", "Initial temperature; default ambient.temperature")
+                      .in("°C")
+                      .above(-273.15)
+                      .at_most(3000)
+                      .optional(),
+                  choice("buoyancy", {"boussinesq", "none"},
+                         "boussinesq: warm air rises, feeling -beta (T - T0) g (its own weight is left to a "
+                         "hydrostatic pressure of a few pascals); none: air feels no gravity")
+                      .def("boussinesq"),
+                  number("reference_temperature",
+                         "T0, where air has its rest density; default its temperature")
+                      .in("°C")
+                      .above(-273.15)
+                      .at_most(3000)
+                      .optional(),
+                  number("expansion",
+                         "Thermal expansion coefficient beta; default 1 / (T0 + 273.15 K), an "
+                         "ideal gas's")
+                      .in("1/K")
+                      .at_least(0)
+                      .at_most(1)
+                      .optional(),
+              },
+              "Air as particles (Domaradzki & Martyn sec. 6): the domain, or a region of it, filled with an "
+              "air material on the particle lattice, except where fluid, ice or solids are. Warm air rises; "
+              "heat crosses it by conduction and is carried with it.")
+              .optional(),
           array_of(
               "ice",
               shaped_entry(
@@ -584,8 +631,9 @@ Checked across fields:
 - an ice material's `melts_into` names a fluid, and no two ice materials melt into the same fluid; ice
   starts at or below its melting point, and a fluid that freezes starts at or above it;
 - `solver.min_dt` is below `solver.max_dt`;
-- `solver.periodic` axes need `solver.flow = false`, no walls on those axes, and a domain at least three
-  kernel supports long along them.
+- `solver.periodic` axes have no walls and no open sides, and a domain at least three kernel supports long
+  along them; with `solver.flow` only y and z can be periodic (particles that leave through one side come
+  back through the other), and ice is fixed.
 
 Temperatures are in °C. Each particle carries its specific enthalpy; an ice particle turns to water when
 it has taken its whole latent heat, and water freezes when it has given it all back

@@ -83,6 +83,7 @@ SolverConstants derive_constants(const Scene& scene) {
   if (fluid_material < 0 && !scene.emitters.empty()) fluid_material = scene.emitters.front().material;
   for (const auto& c : scene.ice)
     if (fluid_material < 0) fluid_material = scene.materials[static_cast<std::size_t>(c.material)].partner;
+  if (fluid_material < 0 && scene.has_air()) fluid_material = scene.air.material;
   const Material* fluid = fluid_material >= 0 ? &scene.materials[fluid_material] : nullptr;
   k.rest_density = static_cast<float>(fluid ? fluid->density : 1000.0);
   // The viscous limit on dt takes the largest kinematic viscosity of any fluid present or melted into.
@@ -90,12 +91,13 @@ SolverConstants derive_constants(const Scene& scene) {
   auto consider = [&](int m) {
     if (m < 0) return;
     const Material& mat = scene.materials[static_cast<std::size_t>(m)];
-    if (mat.kind == MaterialKind::Fluid)
+    if (mat.kind == MaterialKind::Fluid || mat.kind == MaterialKind::Air)
       nu = std::max(nu, double(static_cast<float>(mat.viscosity / mat.density)));
   };
   for (const auto& f : scene.fluids) consider(f.material);
   for (const auto& c : scene.ice) consider(scene.materials[static_cast<std::size_t>(c.material)].partner);
   for (const auto& e : scene.emitters) consider(e.material);
+  if (scene.has_air()) consider(scene.air.material);
   k.kinematic_viscosity = static_cast<float>(nu);
 
   // Reference speed: free fall from the highest fluid or ice to the bottom of the domain, or the fastest
@@ -147,7 +149,7 @@ SolverConstants derive_constants(const Scene& scene) {
   k.exposed_capacity = inf;
   k.wall_dt = inf;
   for (const Material& m : scene.materials) {
-    if (m.kind != MaterialKind::Solid)
+    if (m.kind == MaterialKind::Fluid || m.kind == MaterialKind::Ice)
       k.exposed_capacity = std::min(k.exposed_capacity, m.density * m.specific_heat * dx / 6.0);
     if (m.wall_heat) {
       k.wall_dt = std::min(k.wall_dt, 0.5 * m.density * m.specific_heat * dx * wall_layer_count(scene) /
@@ -208,6 +210,10 @@ std::string program_options(const Scene& scene) {
   // start (measured: docs/BENCHMARKS.md). Nothing physical lives below 1e-38.
   opts << " -cl-denorms-are-zero";
   opts << " -DTHAW_REACH=" << kGridReach << " -DTHAW_VW=" << kLanes;
+  // Periodic y and z axes wrap the neighbour rows of every pass (grid_common.h); x wraps in the heat-only
+  // mode alone, where the heat pass walks cell by cell (heat.cl).
+  if (scene.solver.periodic[1]) opts << " -DTHAW_ROW_WRAP_Y";
+  if (scene.solver.periodic[2]) opts << " -DTHAW_ROW_WRAP_Z";
   return opts.str();
 }
 
@@ -297,7 +303,8 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   grid_built_ = false;
   f_ = add_core_fields(store_);
   grid_ = std::make_unique<NeighbourGrid>(cl_, scene_, k_.support, kGridReach, opts, layout_, lo, hi);
-  if (scene_.solver.flow) fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_);
+  if (scene_.solver.flow)
+    fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_, plan.build);
   if (fluid_ && scene_.solver.pressure == PressureSolver::Dfsph)
     dfsph_ = std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow());
   if (dfsph_) fluid_->compute_dfsph_alpha(dfsph_->columns(), dfsph_->min_neighbours());
@@ -307,6 +314,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
                          : cl::Buffer();
   if (plan.build)
     heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
+  if (fluid_ && heat_) fluid_->buoyancy_from(heat_->enthalpy());
   store_.allocate(layout_.capacity);
   store_.resize(n_);
 
@@ -530,7 +538,12 @@ double Solver::choose_time_step() {
     dt = std::min(dt, s.cfl * h / (k_.sound_speed + vmax));  // CFL (acoustic + advective)
   }
   if (amax2 > 0) dt = std::min(dt, s.force_number * std::sqrt(h / std::sqrt(amax2)));
-  if (k_.kinematic_viscosity > 0) dt = std::min(dt, s.viscous_number * h * h / k_.kinematic_viscosity);
+  // The viscous pair sum's stiffness grows with the neighbours a particle has per spacing, not with the
+  // kernel's width: the limit takes the smaller of h and the spacing (Wendland C2 over 3 spacings has
+  // h = 1.5 dx, and no-slip walls' ghost velocities, which double a wall pair's velocity difference, blew
+  // a plane Poiseuille flow up in 160 steps at 0.125 h^2 / nu; 0.05 h^2 / nu ran).
+  const double hv = std::min(double(h), scene_.spacing);
+  if (k_.kinematic_viscosity > 0) dt = std::min(dt, s.viscous_number * hv * hv / k_.kinematic_viscosity);
   const double dt_heat = heat_time_step();
   dt = std::min(dt, dt_heat);
   dt = static_cast<float>(dt);  // the kernels see a float: keep host time consistent with them
@@ -715,6 +728,12 @@ std::vector<std::string> Solver::stages() const {
   if (heat_) out.push_back("heat (" + heat_reason_ + ")");
   if (fluid_) out.push_back("integrate");
   if (emitters_) out.push_back("emit");
+  return out;
+}
+
+std::vector<double> Solver::held_power() const {
+  std::vector<double> out;
+  if (heat_) out = heat_->held_power(store_[f_.material], scene_.materials.size());
   return out;
 }
 

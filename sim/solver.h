@@ -176,6 +176,10 @@ class Solver {
     std::vector<float> temperature, conductivity, volume;
   };
   ThermalInputs thermal_inputs() const;
+  // The power [W] each material's held particles gave the rest in the last heat step (negative: took),
+  // one entry per Scene::materials (0 for those not held); empty without heat. A hot and a cold held
+  // wall are materials of their own, so this splits what the energy budget's `held` sums.
+  std::vector<double> held_power() const;
 
  private:
   // Builds the stages this scene needs for `capacity` particles (0: as the state says, or its particles

@@ -35,7 +35,7 @@ Law law_of(const Scene& scene, int material) {
 }  // namespace
 
 double mass_scale(const Material& m, double rest_density) {
-  return m.kind == MaterialKind::Fluid ? 1.0 : m.density / rest_density;
+  return m.kind == MaterialKind::Fluid || m.kind == MaterialKind::Air ? 1.0 : m.density / rest_density;
 }
 
 std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density) {
@@ -58,7 +58,13 @@ std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double r
       t.flags |= law.ice ? THAW_MAT_MELTS : THAW_MAT_FREEZES;
     }
     t.thermal_mass_scale = static_cast<float>(mass_scale(m, rest_density));
-    if (m.kind != MaterialKind::Solid) t.flags |= THAW_MAT_AIR_EXCHANGE;
+    // The ambient model stands for air that is not there as particles (plan_heat: off where it is).
+    if (m.kind == MaterialKind::Fluid || m.kind == MaterialKind::Ice) t.flags |= THAW_MAT_AIR_EXCHANGE;
+    if (m.adiabatic) {
+      // Its T and k are those of what is around it (heat.cl, adiabatic_state); it keeps its own enthalpy,
+      // the heat its mirrored temperature exchanges booked as `held`.
+      t.flags |= THAW_MAT_ADIABATIC;
+    }
     if (m.held) {
       t.flags |= THAW_MAT_HELD;
       t.held_enthalpy = static_cast<float>(enthalpy_at(scene, static_cast<int>(i), m.held_temperature));
@@ -112,7 +118,10 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
   const bool wall_heat = std::any_of(scene.materials.begin(), scene.materials.end(),
                                      [](const Material& m) { return m.wall_heat; });
   plan.walls = wall_heat && scene.heat.wall_coefficient > 0;
-  plan.ambient = scene.heat.ambient_coefficient > 0;
+  // Air particles carry the air's heat themselves: the ambient model, which stands for the air, is off.
+  plan.ambient = scene.heat.ambient_coefficient > 0 && !scene.has_air();
+  plan.adiabatic = std::any_of(scene.materials.begin(), scene.materials.end(),
+                               [](const Material& m) { return m.adiabatic; });
 
   // Temperatures differ by round-off only when each came from the same temperature through a float
   // enthalpy pair: a thousandth of a millikelvin is no difference.
@@ -160,6 +169,7 @@ double max_diffusivity(const Scene& scene) {
   for (const auto& f : scene.fluids) use(f.material);
   for (const auto& c : scene.ice) use(c.material);
   for (const auto& e : scene.emitters) use(e.material);
+  if (scene.has_air()) use(scene.air.material);
   for (const auto& s : scene.solids) use(s.material);
   if (!scene.walls.empty()) use(scene.wall_material);
   double alpha = 0;

@@ -48,6 +48,7 @@ struct HeatPlan {
   bool dryers = false;   // the scene has dryers
   bool walls = false;    // tank walls exchange heat with the outside (heat.wall_coefficient > 0)
   bool lamps = false;    // the scene has lamps (the photon grid is built once one is on)
+  bool adiabatic = false;  // the scene has adiabatic solids (their mirrored temperatures: heat.cl)
   std::string reason;    // why heat is built or not, in words, for `thaw run`'s list of stages
 };
 HeatPlan plan_heat(const Scene& scene, const HostParticles& particles);

@@ -11,8 +11,10 @@ kernel void boundary_psi(global const float4* pos, global const uchar* phase, gl
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   float sum = 0.0f;
-  FOR_EACH_NEIGHBOUR(g, cell_start, c, j) {
-    if (phase[j] == THAW_PHASE_SOLID) sum += KERNEL_W(fast_length(pi.xyz - pos[j].xyz), H);
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
+    for (uint j = jb; j < je; ++j)
+      if (phase[j] == THAW_PHASE_SOLID) sum += KERNEL_W(fast_length(pr.xyz - pos[j].xyz), H);
   }
   psi[i] = rho0 / sum;
 }

@@ -14,6 +14,10 @@ kernel void density(global const float4* pos, global const float* soa, global co
                     ,
                     global float* col, const uint min_neighbours
 #endif
+#ifdef THAW_NO_SLIP
+                    ,
+                    global float* ghost
+#endif
 ) {
   const uint i = get_global_id(0);
   const uint n = P.n, stride = P.stride;
@@ -40,17 +44,36 @@ kernel void density(global const float4* pos, global const float* soa, global co
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
   floatV count = (floatV)(0.0f);
 #endif
+#ifdef THAW_NO_SLIP
+  /* A boundary particle's Shepard average of the fluid's velocity around it (Adami et al. 2012 eq 22). */
+  global const float* VX = soa + 4 * stride;
+  global const float* VY = soa + 5 * stride;
+  global const float* VZ = soa + 6 * stride;
+  floatV fu = (floatV)(0.0f), fv = (floatV)(0.0f), fw = (floatV)(0.0f), fs = (floatV)(0.0f);
+#endif
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pi.x - vloadV(0, X + j);
-      const floatV dy = pi.y - vloadV(0, Y + j);
-      const floatV dz = pi.z - vloadV(0, Z + j);
+      const floatV dx = pr.x - vloadV(0, X + j);
+      const floatV dy = pr.y - vloadV(0, Y + j);
+      const floatV dz = pr.z - vloadV(0, Z + j);
       const floatV r2 = dx * dx + dy * dy + dz * dz;
       /* Lanes past the row's end, or outside the support, add nothing (a select, not a branch). */
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
       const floatV m = vloadV(0, M + j);
       const floatV q = sqrt(r2) * inv_H;
       acc += select((floatV)(0.0f), m * w_shape(q), in);
+#ifdef THAW_NO_SLIP
+      if (boundary) {
+        const intV ph = THAW_CAT(convert_int, THAW_VW)(THAW_CAT(vload, THAW_VW)(0, phase + j));
+        const floatV wf =
+            select((floatV)(0.0f), m * w_shape(q), in & ((ph == THAW_PHASE_WATER) | (ph == THAW_PHASE_AIR)));
+        fu += wf * vloadV(0, VX + j);
+        fv += wf * vloadV(0, VY + j);
+        fw += wf * vloadV(0, VZ + j);
+        fs += wf;
+      }
+#endif
 #ifdef THAW_DFSPH
       const floatV fm = vloadV(0, FM + j);
       if (boundary) {
@@ -68,6 +91,19 @@ kernel void density(global const float4* pos, global const float* soa, global co
     }
   }
   const float rho = THAW_SIGMA(H) * lanes_sum(acc);
+#ifdef THAW_NO_SLIP
+  /* The velocity the forces pass's viscous term gives each particle (blocks of `stride` floats): a
+   * boundary particle's ghost 2 v_w - v~ (eq 23: the fluid's velocity mirrored through the wall moving with
+   * v_w, so that the wall's surface holds v_w), a fluid particle's own. */
+  {
+    float3 v = (float3)(VX[i], VY[i], VZ[i]);
+    const float s = lanes_sum(fs);
+    if (boundary && s > 0.0f) v = 2.0f * v - (float3)(lanes_sum(fu), lanes_sum(fv), lanes_sum(fw)) / s;
+    ghost[i] = v.x;
+    ghost[stride + i] = v.y;
+    ghost[2 * stride + i] = v.z;
+  }
+#endif
 #ifdef THAW_DFSPH
   /* alpha_i = rho_i / (|G_i|^2 + S_i) for both solves (Bender & Koschier 2015 eq 10; dfsph.cl has the
    * columns). A boundary particle's AD is -1 when fluid is within its support (the solves extrapolate a
@@ -108,7 +144,12 @@ kernel void density(global const float4* pos, global const float* soa, global co
   const float dp = p / (rho * rho);
   density[i] = rho;
   state[i] = (float4)(rho, dp, boundary ? 1.0f : 0.0f, p);
+#ifdef THAW_NO_SLIP
+  /* No-slip: a boundary pair takes the fluid's viscosity (the boundary material's row holds the fluid's). */
+  derived[i] = mf.viscosity * pi.w / rho;
+#else
   derived[i] = (boundary ? P.visc_boundary : mf.viscosity) * pi.w / rho;
+#endif
   derived[stride + i] = pi.w * dp;
   derived[2 * stride + i] = phase[i] == THAW_PHASE_SOLID ? pi.w : 0.0f;
 }

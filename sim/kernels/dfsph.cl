@@ -91,8 +91,9 @@ float density_rate(const float4 pi, const float3 vi, global const float* soa, gl
   global const float* VZ = soa + 6 * stride;
   floatV acc = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      DFSPH_LANES(pi, j, je, H2)
+      DFSPH_LANES(pr, j, je, H2)
       const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
                         (vi.z - vloadV(0, VZ + j)) * dz;
       const floatV t = vloadV(0, M + j) * grad_shape(sqrt(r2) * inv_H) * vd;
@@ -164,8 +165,9 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
   global const float* KR = col + COL_KR * stride;
   floatV num = (floatV)(0.0f), den = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      DFSPH_LANES(pi, j, je, H2)
+      DFSPH_LANES(pr, j, je, H2)
       const floatV w = vloadV(0, FM + j) * w_shape(sqrt(r2) * inv_H); /* 0 for boundary neighbours */
       const floatV rho_j = vloadV(0, density + j);
       floatV p = vloadV(0, KR + j) * rho_j * rho_j;
@@ -239,8 +241,9 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
   DFSPH_SOA(soa, stride)
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      DFSPH_LANES(pi, j, je, H2)
+      DFSPH_LANES(pr, j, je, H2)
       const floatV t = vloadV(0, M + j) * (kri + vloadV(0, KR + j)) * grad_shape(sqrt(r2) * inv_H);
       ax += select((floatV)(0.0f), t * dx, in);
       ay += select((floatV)(0.0f), t * dy, in);

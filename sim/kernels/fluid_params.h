@@ -16,6 +16,14 @@ typedef struct {
   float stiffness;    /* Tait B = rho0 c^2 / gamma, or rho0 c^2 for the linear EOS [Pa] */
   float viscosity;    /* the pair term's coefficient 2(d+2) nu + alpha c h [m^2/s] (Monaghan 2005) */
   float sound_speed;  /* c [m/s] */
+  /* The body force per unit mass is g (gravity - expansion (T - T0)): water 1 and 0; Boussinesq air 0 and
+   * beta (its weight left to a hydrostatic pressure; sim/scene.h, Buoyancy). T = h * inv_specific_heat
+   * (a material without phase change, thermal_law.h), read only in builds with THAW_BUOYANCY. */
+  float gravity;
+  float expansion;             /* beta [1/K] */
+  float reference_temperature; /* T0 [°C] */
+  float inv_specific_heat;     /* 1 / c [kg K/J] */
+  float push;                  /* 1: the walls' short-range push acts on it (forces.cl); 0: not (air) */
 } MaterialFlow;
 
 typedef struct {
@@ -40,7 +48,7 @@ typedef struct {
 } ForcesParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(MaterialFlow) == 16, "MaterialFlow must match its OpenCL layout");
+static_assert(sizeof(MaterialFlow) == 36, "MaterialFlow must match its OpenCL layout");
 static_assert(sizeof(DensityParams) == 32, "DensityParams must match its OpenCL layout");
 static_assert(sizeof(ForcesParams) == 48, "ForcesParams must match its OpenCL layout");
 }  // namespace thaw::fluid

@@ -35,7 +35,16 @@ floatV repulsion(const floatV r, const floatV vd, const float r0, const float d)
 kernel void forces(global const float4* pos, global const float4* vel, global const float* soa,
                    global const float* derived, global const float4* state, global const uchar* phase,
                    global const uchar* material, global const MaterialFlow* flow, global const uint* cell_start,
-                   const Grid g, const ForcesParams P, global float4* accel) {
+                   const Grid g, const ForcesParams P, global float4* accel
+#ifdef THAW_BUOYANCY
+                   ,
+                   global const float2* enthalpy
+#endif
+#ifdef THAW_NO_SLIP
+                   ,
+                   global const float* ghost
+#endif
+) {
   const uint i = get_global_id(0);
   const uint n = P.n, stride = P.stride;
   if (i >= n) return;
@@ -48,7 +57,15 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
   const float4 pi = pos[i];
   const float4 vi = vel[i];
   const float dpi = state[i].y;
-  const float visc_i = flow[material[i]].rest_density / state[i].x; /* the viscous pair term's rho0 / rho_i */
+  const MaterialFlow mf = flow[material[i]];
+  const float visc_i = mf.rest_density / state[i].x; /* the viscous pair term's rho0 / rho_i */
+  /* Body force per unit mass (fluid_params.h): gravity, or Boussinesq air's buoyancy. */
+#ifdef THAW_BUOYANCY
+  const float2 h = enthalpy[i];
+  const float body = mf.gravity - mf.expansion * ((h.x + h.y) * mf.inv_specific_heat - mf.reference_temperature);
+#else
+  const float body = mf.gravity;
+#endif
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
   const float inv_H = 1.0f / H;
@@ -56,20 +73,28 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
   global const float* Y = soa + stride;
   global const float* Z = soa + 2 * stride;
   global const float* M = soa + 3 * stride;
+#ifdef THAW_NO_SLIP
+  /* Boundary particles with their ghost velocities (density.cl), fluid ones with their own. */
+  global const float* VX = ghost;
+  global const float* VY = ghost + stride;
+  global const float* VZ = ghost + 2 * stride;
+#else
   global const float* VX = soa + 4 * stride;
   global const float* VY = soa + 5 * stride;
   global const float* VZ = soa + 6 * stride;
+#endif
   global const float* KV = derived;
   global const float* MP = derived + stride;
   global const float* RB = derived + 2 * stride; /* m_j for solid particles, 0 for the rest */
   const float scale = THAW_SIGMA(H) * inv_H * inv_H;
-  const float rep = rep_k / scale; /* the sum below is scaled by `scale` at the end */
+  const float rep = mf.push * rep_k / scale; /* the sum below is scaled by `scale` at the end */
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pi.x - vloadV(0, X + j);
-      const floatV dy = pi.y - vloadV(0, Y + j);
-      const floatV dz = pi.z - vloadV(0, Z + j);
+      const floatV dx = pr.x - vloadV(0, X + j);
+      const floatV dy = pr.y - vloadV(0, Y + j);
+      const floatV dz = pr.z - vloadV(0, Z + j);
       const floatV r2 = dx * dx + dy * dy + dz * dz;
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
       const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
@@ -89,5 +114,5 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
     }
   }
   const float3 a = scale * (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
-  accel[i] = (float4)(a + gravity.xyz, 0.0f);
+  accel[i] = (float4)(a + body * gravity.xyz, 0.0f);
 }

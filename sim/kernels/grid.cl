@@ -16,6 +16,18 @@ kernel void cell_keys(global float4* pos, global float4* vel, global const uchar
   float4 p = pos[i];
   order[i] = i;
   if (!THAW_IS_STATIC(phase[i])) {
+#if THAW_WY || THAW_WZ
+    /* Along a periodic axis a particle that left through one side comes back through the other. */
+    const float4 span = dmax - dmin;
+    float4 w = p;
+    /* (Rounding can land a particle just below the lower side on the upper one: kept inside.) */
+    if (THAW_WY) w.y = fmin(p.y - span.y * floor((p.y - dmin.y) / span.y), dmax.y);
+    if (THAW_WZ) w.z = fmin(p.z - span.z * floor((p.z - dmin.z) / span.z), dmax.z);
+    if (w.y != p.y || w.z != p.z) {
+      pos[i] = w;
+      p = w;
+    }
+#endif
     const int4 below = isless(p, dmin);
     const int4 above = isgreater(p, dmax);
     if (any(below.xyz) || any(above.xyz)) {

@@ -39,11 +39,52 @@ int4 grid_cell(const Grid g, float4 p) {
 
 uint grid_key(const Grid g, int4 c) { return (uint)((c.z * g.ny + c.y) * g.nx + c.x); }
 
+/* Periodic y and z axes (solver.periodic; -DTHAW_ROW_WRAP_Y/Z): the grid wraps there, its cells divide
+ * the domain's length exactly (sim/neighbour_grid.cpp) and the scene guarantees at least three of them,
+ * so no row is visited twice. Rows stay contiguous along x, which never wraps in a flowing scene. */
+#ifdef THAW_ROW_WRAP_Y
+#define THAW_WY 1
+#else
+#define THAW_WY 0
+#endif
+#ifdef THAW_ROW_WRAP_Z
+#define THAW_WZ 1
+#else
+#define THAW_WZ 0
+#endif
+
 /* The first cell of row (dz, dy) around cell c, or -1 where that row lies outside the grid. */
 int neighbour_row(const Grid g, const int4 c, const int dz, const int dy) {
-  const int z = c.z + dz, y = c.y + dy;
+  int z = c.z + dz, y = c.y + dy;
+  if (THAW_WZ) z = (z + g.nz) % g.nz;
+  if (THAW_WY) y = (y + g.ny) % g.ny;
   return (z < 0 || z >= g.nz || y < 0 || y >= g.ny) ? -1 : (z * g.ny + y) * g.nx;
 }
+
+/* What a particle's position p becomes for the neighbours in row (dz, dy) around its cell c: moved by a
+ * period where the row wrapped, so that p - x_j is the nearest image's offset (minimum image). */
+float4 row_image(const Grid g, const int4 c, const int dz, const int dy, const float4 p) {
+  float4 q = p;
+  if (THAW_WY) {
+    const int y = c.y + dy;
+    const float L = (float)g.ny / g.inv_cell.y;
+    q.y += y < 0 ? L : (y >= g.ny ? -L : 0.0f);
+  }
+  if (THAW_WZ) {
+    const int z = c.z + dz;
+    const float L = (float)g.nz / g.inv_cell.z;
+    q.z += z < 0 ? L : (z >= g.nz ? -L : 0.0f);
+  }
+  return q;
+}
+
+/* Inside FOR_EACH_NEIGHBOUR_ROW: p as the current row's neighbours see it (row_image); p itself where no
+ * axis wraps. */
+#if THAW_WY || THAW_WZ
+#define THAW_ROW_POS(g, c, p) row_image(g, c, dz_, dy_, p)
+#else
+#define THAW_ROW_POS(g, c, p) (p)
+#endif
 
 /* Visits the (2 THAW_REACH + 1)^2 rows of cells around cell c; the statement that follows it sees each
  * row's contiguous range [jb, je) of sorted particles:

@@ -30,6 +30,7 @@ namespace thaw::thermal {
 #define THAW_MAT_FREEZES 4u     /* fluid: becomes `partner` (ice) when its liquid fraction reaches 0 */
 #define THAW_MAT_WALL_HEAT 8u   /* tank wall: exchanges heat with the outside (Domaradzki & Martyn sec. 7) */
 #define THAW_MAT_AIR_EXCHANGE 16u /* exposed surface exchanges heat with the ambient air and the dryers */
+#define THAW_MAT_ADIABATIC 32u    /* an ideal insulator: mirrors the temperature around it (heat.cl) */
 
 /* One material's thermal data; every member is 4 bytes, so host and device layouts agree. */
 typedef struct {

@@ -52,6 +52,7 @@ ValidationCase conduction_case();
 ValidationCase stefan_case();
 ValidationCase rigid_spin_case();
 ValidationCase floating_case();
+ValidationCase cavity_case();
 
 }  // namespace thaw
 

@@ -446,7 +446,7 @@ TEST(HeatScene, ErrorsNameTheirPath) {
   EXPECT_EQ(error_path(doc), "materials.water.specific_heat");
   doc = base;
   doc["solver"]["flow"] = true;
-  doc["solver"]["periodic"] = {"y"};
+  doc["solver"]["periodic"] = {"x"};  // flowing particles wrap along y and z only
   EXPECT_EQ(error_path(doc), "solver.periodic");
   doc = base;
   doc["domain"]["wall_heat"] = {{"coefficient", 10}};

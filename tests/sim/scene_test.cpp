@@ -91,7 +91,7 @@ TEST(Scene, EveryShippedConfigLoads) {
     EXPECT_NO_THROW({
       const Scene s = load_scene(entry.path().string());
       EXPECT_FALSE(s.name.empty());
-      EXPECT_FALSE(s.fluids.empty() && s.ice.empty());
+      EXPECT_FALSE(s.fluids.empty() && s.ice.empty() && !s.has_air());
     });
     ++count;
   }

@@ -1,0 +1,305 @@
+// Air as particles (issue 18, first part): the `air` fill, its scene errors, the heat plan without the
+// ambient model, periodic flowing axes, Boussinesq buoyancy with no-slip walls against the exact flow
+// between two held plates, and the differentially heated cavity (sim/validation/cavity.cpp).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "sim/error.h"
+#include "sim/metrics.h"
+#include "sim/solver.h"
+#include "sim/thermal.h"
+#include "sim/validation/case.h"
+#include "tests/test_support.h"
+
+namespace thaw {
+namespace {
+
+using testing::ClSuite;
+
+constexpr auto kAir = static_cast<std::uint8_t>(Phase::Air);
+
+Json box(double x0, double y0, double z0, double x1, double y1, double z1) {
+  return {{"min", {x0, y0, z0}}, {"max", {x1, y1, z1}}};
+}
+
+Json materials() {
+  return {
+      {"air",
+       {{"kind", "air"},
+        {"density", 1.2},
+        {"viscosity", 1.8e-5},
+        {"conductivity", 0.025},
+        {"specific_heat", 1006.0}}},
+      {"water",
+       {{"kind", "fluid"},
+        {"density", 1000.0},
+        {"viscosity", 1e-3},
+        {"conductivity", 0.56},
+        {"specific_heat", 4217.0}}},
+      {"ice",
+       {{"kind", "ice"},
+        {"density", 917.0},
+        {"conductivity", 2.22},
+        {"specific_heat", 2050.0},
+        {"melts_into", "water"}}},
+      {"plate", {{"kind", "solid"}, {"density", 1.2}, {"conductivity", 0.025}, {"specific_heat", 1006.0}}}};
+}
+
+// A 4 x 4 x 4 cm box of air around a 1 cm cube of steel-like solid, at 5 mm.
+Json air_box() {
+  return {{"name", "air box"},
+          {"domain",
+           {{"min", {0, 0, 0}}, {"max", {0.04, 0.04, 0.04}}, {"walls", {"-z"}}, {"wall_material", "plate"}}},
+          {"spacing", 0.005},
+          {"materials", materials()},
+          {"air", {{"material", "air"}, {"temperature", 30.0}}},
+          {"solids",
+           {{{"shape", "box"}, {"material", "plate"}, {"box", box(0.01, 0.01, 0.01, 0.02, 0.02, 0.02)}}}}};
+}
+
+std::string error_path(Json doc) {
+  try {
+    scene_from_json(std::move(doc));
+  } catch (const SceneError& e) {
+    return e.path();
+  }
+  return "(no error)";
+}
+
+// The fill: the domain's lattice less the solid's points, each an air particle of rho dx^3 at the fill's
+// temperature; no water; and air takes no ambient exchange.
+TEST(AirScene, FillsTheDomainAroundSolidsWithAirParticles) {
+  const Scene scene = scene_from_json(air_box());
+  ASSERT_TRUE(scene.has_air());
+  const HostParticles p = initial_state(scene).particles;
+  const auto table = material_thermal_table(scene, derive_constants(scene).rest_density);
+  std::size_t air = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.phase[i] != kAir) continue;
+    ++air;
+    EXPECT_FLOAT_EQ(p.position[i][3], static_cast<float>(1.2 * 0.005 * 0.005 * 0.005));
+    EXPECT_NEAR(temperature_at(table[p.material[i]], double(p.enthalpy[i][0]) + p.enthalpy[i][1]), 30.0,
+                1e-4);
+    EXPECT_EQ(table[p.material[i]].flags & THAW_MAT_AIR_EXCHANGE, 0u);
+  }
+  EXPECT_EQ(air, 8u * 8u * 8u - 2u * 2u * 2u);  // 512 lattice points, 8 inside the cube
+  EXPECT_EQ(p.count(Phase::Water), 0u);
+  // The boundary particles carry the air's rest density (Akinci 2012): it is the only fluid.
+  EXPECT_FLOAT_EQ(derive_constants(scene).rest_density, 1.2f);
+}
+
+// With air particles the ambient model, which stands for the air, is off; the same scene without them
+// keeps it.
+TEST(AirScene, AirParticlesSwitchTheAmbientModelOff) {
+  Json doc = air_box();
+  doc["fluids"] = {{{"material", "water"}, {"box", box(0, 0, 0, 0.04, 0.04, 0.01)}, {"temperature", 10.0}}};
+  doc["air"]["region"] = box(0, 0, 0.01, 0.04, 0.04, 0.04);
+  doc["materials"]["water"]["density"] = 1.2;  // one rest density until the multiphase model
+  const Scene with = scene_from_json(doc);
+  const HeatPlan a = plan_heat(with, initial_state(with).particles);
+  EXPECT_TRUE(a.build);
+  EXPECT_FALSE(a.ambient);
+  doc.erase("air");
+  const Scene without = scene_from_json(doc);
+  EXPECT_TRUE(plan_heat(without, initial_state(without).particles).ambient);
+}
+
+TEST(AirScene, ErrorsNameTheirPath) {
+  Json doc = air_box();
+  doc["air"]["material"] = "water";
+  EXPECT_EQ(error_path(doc), "air.material");
+  doc = air_box();
+  doc["air"]["region"] = box(0, 0, 0, 0.05, 0.04, 0.04);
+  EXPECT_EQ(error_path(doc), "air.region");
+  doc = air_box();
+  doc["air"]["buoyancy"] = "ideal";
+  EXPECT_EQ(error_path(doc), "air.buoyancy");
+  // The cone dryer stands in for air that is not there.
+  doc = air_box();
+  doc["dryers"] = {{{"position", {0.02, 0.02, 0.04}}, {"direction", {0, 0, -1}}}};
+  EXPECT_EQ(error_path(doc), "dryers[0]");
+  // Flowing particles wrap along y and z only; free ice cannot cross a periodic side.
+  doc = air_box();
+  doc["domain"]["walls"] = Json::array();
+  doc["solver"] = {{"periodic", {"x"}}};
+  EXPECT_EQ(error_path(doc), "solver.periodic");
+  doc["solver"] = {{"periodic", {"y"}}};
+  doc["ice"] = {
+      {{"material", "ice"}, {"box", box(0.025, 0.025, 0.025, 0.035, 0.035, 0.035)}, {"motion", "free"}}};
+  EXPECT_EQ(error_path(doc), "ice[0].motion");
+  doc["solver"] = {{"no_slip", "adami2012"}};
+  EXPECT_EQ(error_path(doc), "solver.no_slip");
+  // An adiabatic solid passes no heat: holding its temperature means nothing.
+  doc = air_box();
+  doc["materials"]["plate"]["adiabatic"] = true;
+  doc["solids"][0]["hold_temperature"] = true;
+  EXPECT_EQ(error_path(doc), "solids[0].hold_temperature");
+  doc["materials"]["air"]["adiabatic"] = true;
+  EXPECT_EQ(error_path(doc), "materials.air.adiabatic");
+}
+
+class AirTest : public ClSuite {};
+
+// Air and water of different rest densities need the multiphase model this build does not have yet: the
+// solver refuses them, naming the air.
+TEST_F(AirTest, AirBesideWaterOfAnotherDensityIsRefusedByName) {
+  Json doc = air_box();
+  doc["fluids"] = {{{"material", "water"}, {"box", box(0, 0, 0, 0.04, 0.04, 0.01)}}};
+  doc["air"]["region"] = box(0, 0, 0.01, 0.04, 0.04, 0.04);
+  const Scene two = scene_from_json(doc);
+  try {
+    Solver s(cl(), two, initial_state(two));
+    ADD_FAILURE() << "two rest densities were accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path(), "air.material");
+    EXPECT_NE(std::string(e.what()).find("multiphase"), std::string::npos) << e.what();
+  }
+}
+
+// Water filling a box periodic in y and z, walled in x, moving uniformly along y and z in zero gravity:
+// particles leave through one side and come back through the other, nothing is clamped, the density
+// stays uniform across the seams (a wrong image would show there first) and the velocity stays as it was.
+TEST_F(AirTest, ParticlesLeavingThroughAPeriodicSideComeBackThroughTheOther) {
+  const double dx = 0.005;
+  Json doc = {
+      {"name", "periodic flow"},
+      {"domain",
+       {{"min", {0, 0, 0}},
+        {"max", {0.04, 0.04, 0.04}},
+        {"walls", {"-x", "+x"}},
+        {"wall_material", "plate"}}},
+      {"spacing", dx},
+      {"gravity", {0, 0, 0}},
+      {"materials", materials()},
+      {"fluids",
+       {{{"material", "water"}, {"box", box(0, 0, 0, 0.04, 0.04, 0.04)}, {"velocity", {0, 0.2, -0.3}}}}},
+      {"solver", {{"periodic", {"y", "z"}}, {"pressure", "dfsph"}, {"artificial_viscosity", 0.0}}}};
+  doc["materials"]["plate"]["density"] = 1000.0;
+  const Scene scene = scene_from_json(doc);
+  Solver s(cl(), scene, initial_state(scene));
+  const Metrics m0 = measure(s);
+  while (s.time() < 0.2) s.step();  // the water crosses the box 1.5 times along z
+  const Metrics m = measure(s);
+  EXPECT_EQ(s.clamped(), 0u);
+  EXPECT_EQ(m.count[static_cast<int>(Phase::Water)], m0.count[static_cast<int>(Phase::Water)]);
+  EXPECT_LT(m.max_density_error, 1e-3);
+  const HostParticles p = s.particles();
+  double vy = 0, vz = 0, spread = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.phase[i] != static_cast<std::uint8_t>(Phase::Water)) continue;
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_GE(p.position[i][a], 0.0f);
+      EXPECT_LE(p.position[i][a], 0.04f);
+    }
+    vy += p.velocity[i][1];
+    vz += p.velocity[i][2];
+    spread = std::max(spread, std::hypot(p.velocity[i][1] - 0.2, p.velocity[i][2] + 0.3));
+    ++n;
+  }
+  EXPECT_NEAR(vy / double(n), 0.2, 1e-4);
+  EXPECT_NEAR(vz / double(n), -0.3, 1e-4);
+  EXPECT_LT(spread, 0.01) << "some particle's velocity strayed from the uniform flow";
+}
+
+// Air between two held plates, periodic along y and z (an infinitely tall slot): the steady flow rises
+// on the hot side and sinks on the cold, w = g beta dT W^2 / (12 nu) xi (1 - xi) (1 - 2 xi), and the
+// temperature is linear (conduction alone carries heat across). Tests Boussinesq buoyancy, the no-slip
+// walls (solver.no_slip adami2012) and periodic flowing axes together.
+TEST_F(AirTest, BoussinesqAirBetweenHeldPlatesFlowsAsTheExactCubicProfile) {
+  // 20 particles across, Wendland C2 over 3 spacings as the cavity case uses (with the cubic spline over 2
+  // the peak ran 5-25 % fast, by the depth of the periodic box).
+  constexpr int kAcross = 20;
+  const double W = 0.01, dx = W / kAcross, D = 9 * dx, Hz = 9 * dx, dT = 10.0;
+  const double nu = 1.8e-5 / 1.2, beta = 1.0 / 293.15, g = 9.81;
+  Json doc = {{"name", "slot"},
+              {"domain", {{"min", {0, 0, 0}}, {"max", {W, D, Hz}}}},
+              {"spacing", dx},
+              {"gravity", {0, 0, -g}},
+              {"materials", materials()},
+              {"air", {{"material", "air"}, {"temperature", 20.0}}},
+              {"solids",
+               {{{"shape", "box"},
+                 {"material", "plate"},
+                 {"box", box(-4 * dx, 0, 0, 0, D, Hz)},
+                 {"temperature", 20.0 + dT / 2},
+                 {"hold_temperature", true}},
+                {{"shape", "box"},
+                 {"material", "plate"},
+                 {"box", box(W, 0, 0, W + 4 * dx, D, Hz)},
+                 {"temperature", 20.0 - dT / 2},
+                 {"hold_temperature", true}}}},
+              {"solver",
+               {{"periodic", {"y", "z"}},
+                {"pressure", "dfsph"},
+                {"artificial_viscosity", 0.0},
+                {"kernel", "wendland_c2"},
+                {"support_ratio", 3.0},
+                {"no_slip", "adami2012"},
+                {"reference_speed", 0.05},
+                {"density_tolerance", 0.005},
+                {"max_dt", 0.05}}}};
+  const Scene scene = scene_from_json(doc);
+  Solver s(cl(), scene, initial_state(scene));
+  const double settle = 1.5 * W * W / nu;  // the slowest mode decays as exp(-pi^2 nu t / W^2): to 4e-7
+  while (s.time() < settle) s.step();
+  const HostParticles p = s.particles();
+  const auto table = material_thermal_table(scene, s.constants().rest_density);
+  std::vector<double> w(kAcross, 0.0), T(kAcross, 0.0);
+  std::vector<int> count(kAcross, 0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.phase[i] != kAir) continue;
+    const int b = std::clamp(static_cast<int>(p.position[i][0] / dx), 0, kAcross - 1);
+    w[b] += p.velocity[i][2];
+    T[b] += temperature_at(table[p.material[i]], double(p.enthalpy[i][0]) + p.enthalpy[i][1]);
+    ++count[b];
+  }
+  const double scale = g * beta * dT * W * W / (12.0 * nu);
+  double w_max = 0, w_ref_max = 0;
+  for (int b = 0; b < kAcross; ++b) {
+    ASSERT_GT(count[b], 0);
+    const double xi = (b + 0.5) / kAcross;
+    const double ref = scale * xi * (1 - xi) * (1 - 2 * xi);
+    w[b] /= count[b];
+    T[b] /= count[b];
+    std::printf("[ info ] xi %.2f  w %.5f m/s (exact %.5f)  T %.3f °C (exact %.3f)\n", xi, w[b], ref, T[b],
+                20.0 + dT * (0.5 - xi));
+    EXPECT_NEAR(T[b], 20.0 + dT * (0.5 - xi), 0.01 * dT);
+    // Within 10 % of the peak speed everywhere. Measured: the peak 7 % fast, the first particles at the
+    // walls 6 % of the peak: Adami's ghost velocity mirrors the fluid's average around a wall particle,
+    // not each fluid particle's own distance, and the walls slip a little.
+    EXPECT_NEAR(w[b], ref, 0.1 * scale * 0.0962) << "at xi " << xi;
+    w_max = std::max(w_max, std::abs(w[b]));
+    w_ref_max = std::max(w_ref_max, std::abs(ref));
+  }
+  EXPECT_NEAR(w_max, w_ref_max, 0.1 * w_ref_max);
+  EXPECT_GT(w[2], 0.0);            // rises on the hot side
+  EXPECT_LT(w[kAcross - 3], 0.0);  // sinks on the cold side
+}
+
+// The cavity at Ra 1e3 against de Vahl Davis (1983): Nu within the case's 3 % gate (measured 0.03 %), the
+// mid-line speeds within its 10 % (3 %); docs/VALIDATION-RESULTS.md has Ra 1e4 and 1e5 over resolutions.
+TEST_F(AirTest, CavityMatchesDeVahlDavisAtRa1e3) {
+  const CaseResult r = run_validation(cl(), "cavity", 20, {"rayleigh=1e3"});
+  for (const auto& [key, m] : r.metrics)
+    std::printf("[ info ] %s %.5g (reference %.5g, error %.4g, gate %.3g)\n", key.c_str(), m.value,
+                m.reference, m.error, m.gate);
+  EXPECT_TRUE(r.passed());
+}
+
+// Still air between the held walls conducts as the slab it is (Nu = 1): the held walls sit at their planes,
+// and the adiabatic floor and ceiling pass no heat while the air beside them conducts as in bulk (with
+// conductivity-0 walls instead: Nu 0.965 at res 20).
+TEST_F(AirTest, StillAirInTheCavityConductsAsTheSlabItIs) {
+  const CaseResult r = run_validation(cl(), "cavity", 20, {"buoyancy=none", "time=0.3"});
+  ASSERT_FALSE(r.metrics.empty());
+  EXPECT_NEAR(r.metrics[0].second.value, 1.0, 0.02);
+  EXPECT_TRUE(r.passed());
+}
+
+}  // namespace
+}  // namespace thaw
