@@ -16,6 +16,8 @@
 #include <string>
 
 #include "sim/cl_runtime.h"
+#include "sim/error.h"
+#include "sim/scene.h"
 
 namespace thaw::testing {
 
@@ -108,6 +110,16 @@ inline CommandResult run_thaw(const std::string& args, const TempDir& dir) {
   r.out = read_file_bytes(out);
   r.err = read_file_bytes(err);
   return r;
+}
+
+// The JSON path of the SceneError a scene document raises, or "(no error)".
+inline std::string scene_error_path(Json doc) {
+  try {
+    scene_from_json(std::move(doc));
+  } catch (const SceneError& e) {
+    return e.path();
+  }
+  return "(no error)";
 }
 
 }  // namespace thaw::testing

@@ -83,6 +83,15 @@ int heat_cell(const Grid g, const int4 c, const int dz, const int dy, const int 
 #define THAW_WRAP(d, L) (d)
 #endif
 
+/* The neighbour loops' structure-of-arrays inputs: the reorder's positions and thermal_state's T, k, V. */
+#define HEAT_SOA(soa, thermal, stride)            \
+  global const float* X = (soa);                  \
+  global const float* Y = (soa) + (stride);       \
+  global const float* Z = (soa) + 2 * (stride);   \
+  global const float* TT = (thermal);             \
+  global const float* KK = (thermal) + (stride);  \
+  global const float* VV = (thermal) + 2 * (stride);
+
 #ifdef THAW_ADIABATIC
 /* Adiabatic solids (materials' `adiabatic`): each particle takes the temperature and conductivity of the
  * fluid and ice around it, their Shepard average sum_j V_j W_ij X_j / sum_j V_j W_ij over non-solid
@@ -104,12 +113,7 @@ kernel void adiabatic_state(global const float4* pos, global const uchar* phase,
   const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
-  global const float* TT = thermal;
-  global const float* KK = thermal + stride;
-  global const float* VV = thermal + 2 * stride;
+  HEAT_SOA(soa, thermal, stride)
   floatV st = (floatV)(0.0f), sk = (floatV)(0.0f), sw = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
@@ -187,12 +191,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
   const float inv_H = 1.0f / H;
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
-  global const float* TT = thermal;
-  global const float* KK = thermal + stride;
-  global const float* VV = thermal + 2 * stride;
+  HEAT_SOA(soa, thermal, stride)
   const float Ti = TT[i];
 #ifdef THAW_ADIABATIC
   /* Adiabatic particles (k < 0, adiabatic_state) pair with fluid and ice only. */

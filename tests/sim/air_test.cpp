@@ -61,14 +61,7 @@ Json air_box() {
            {{{"shape", "box"}, {"material", "plate"}, {"box", box(0.01, 0.01, 0.01, 0.02, 0.02, 0.02)}}}}};
 }
 
-std::string error_path(Json doc) {
-  try {
-    scene_from_json(std::move(doc));
-  } catch (const SceneError& e) {
-    return e.path();
-  }
-  return "(no error)";
-}
+std::string error_path(Json doc) { return testing::scene_error_path(std::move(doc)); }
 
 // The fill: the domain's lattice less the solid's points, each an air particle of rho dx^3 at the fill's
 // temperature; no water; and air takes no ambient exchange.

@@ -411,14 +411,7 @@ TEST(ThermalLaw, EnthalpyAndTemperatureInvertAcrossTheMeltingPoint) {
 
 // ---- scene errors ------------------------------------------------------------------------------
 
-std::string error_path(Json doc) {
-  try {
-    scene_from_json(std::move(doc));
-  } catch (const SceneError& e) {
-    return e.path();
-  }
-  return "(no error)";
-}
+std::string error_path(Json doc) { return testing::scene_error_path(std::move(doc)); }
 
 TEST(HeatScene, ErrorsNameTheirPath) {
   Json base = isolated_scene();
