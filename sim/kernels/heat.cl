@@ -92,6 +92,13 @@ int heat_cell(const Grid g, const int4 c, const int dz, const int dy, const int 
   global const float* KK = (thermal) + (stride);  \
   global const float* VV = (thermal) + 2 * (stride);
 
+/* Inside a loop over candidates j..: the lanes' minimum-image offsets x_ij (dx, dy, dz) and r^2. */
+#define HEAT_LANES(pi, j, period)                                          \
+  const floatV dx = THAW_WRAP((pi).x - vloadV(0, X + (j)), (period).x); \
+  const floatV dy = THAW_WRAP((pi).y - vloadV(0, Y + (j)), (period).y); \
+  const floatV dz = THAW_WRAP((pi).z - vloadV(0, Z + (j)), (period).z); \
+  const floatV r2 = dx * dx + dy * dy + dz * dz;
+
 #ifdef THAW_ADIABATIC
 /* Adiabatic solids (materials' `adiabatic`): each particle takes the temperature and conductivity of the
  * fluid and ice around it, their Shepard average sum_j V_j W_ij X_j / sum_j V_j W_ij over non-solid
@@ -117,10 +124,7 @@ kernel void adiabatic_state(global const float4* pos, global const uchar* phase,
   floatV st = (floatV)(0.0f), sk = (floatV)(0.0f), sw = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = THAW_WRAP(pi.x - vloadV(0, X + j), period.x);
-      const floatV dy = THAW_WRAP(pi.y - vloadV(0, Y + j), period.y);
-      const floatV dz = THAW_WRAP(pi.z - vloadV(0, Z + j), period.z);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      HEAT_LANES(pi, j, period)
       const intV ph = THAW_CAT(convert_int, THAW_VW)(THAW_CAT(vload, THAW_VW)(0, phase + j));
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2) & (ph != THAW_PHASE_SOLID);
       const floatV w = select((floatV)(0.0f), vloadV(0, VV + j) * w_shape(sqrt(r2) * inv_H), in);
@@ -204,10 +208,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
   intV covered = (intV)(0);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = THAW_WRAP(pi.x - vloadV(0, X + j), period.x);
-      const floatV dy = THAW_WRAP(pi.y - vloadV(0, Y + j), period.y);
-      const floatV dz = THAW_WRAP(pi.z - vloadV(0, Z + j), period.z);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      HEAT_LANES(pi, j, period)
       const intV lane = THAW_LANE_IDS < (int)(je - j);
 #ifdef THAW_ADIABATIC
       const floatV kraw = vloadV(0, KK + j);
