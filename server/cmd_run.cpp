@@ -222,12 +222,16 @@ int cmd_run(int argc, char** argv) {
                   m.inflow.momentum.y(), m.inflow.momentum.z(), m.budget.inflow);
     if (m.heat) {
       const EnergyBudget& b = m.budget;
+      // The ice and water's temperatures where there are any (a scene of air alone has none).
+      char range[96] = "";
+      if (m.count[static_cast<int>(Phase::Water)] || m.count[static_cast<int>(Phase::Ice)])
+        std::snprintf(range, sizeof range, ", temperature %.4g..%.4g °C (mean %.4g)", m.min_temperature,
+                      m.max_temperature, m.mean_temperature);
       std::printf(
-          "heat: ice %.6g kg, water %.6g kg, temperature %.4g..%.4g °C (mean %.4g); heat in %.6g J "
-          "(ambient %.4g, lamps %.4g, dryers %.4g, walls %.4g, held %.4g, outflow %.4g, inflow %.4g), energy "
-          "closure %.3g J\n",
-          m.ice_mass, m.water_mass, m.min_temperature, m.max_temperature, m.mean_temperature, b.heat_in(),
-          b.ambient, b.lamps, b.dryers, b.walls, b.held, -b.outflow, b.inflow, m.closure());
+          "heat: ice %.6g kg, water %.6g kg%s; heat in %.6g J (ambient %.4g, lamps %.4g, dryers %.4g, walls "
+          "%.4g, held %.4g, outflow %.4g, inflow %.4g), energy closure %.3g J\n",
+          m.ice_mass, m.water_mass, range, b.heat_in(), b.ambient, b.lamps, b.dryers, b.walls, b.held,
+          -b.outflow, b.inflow, m.closure());
       if (m.count[static_cast<int>(Phase::Air)])
         std::printf("air: %.6g kg, temperature %.4g..%.4g °C (mean %.4g)\n", m.air_mass,
                     m.air_min_temperature, m.air_max_temperature, m.air_mean_temperature);

@@ -47,7 +47,7 @@ std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const S
   std::vector<fluid::MaterialFlow> table;
   for (const Material& m : scene.materials) {
     // A boundary material carries rho0 V of the fluid it bounds: the fluid's row (Akinci 2012).
-    const bool fluid = m.kind == MaterialKind::Fluid || m.kind == MaterialKind::Air;
+    const bool fluid = flows(m.kind);
     table.push_back(
         fluid ? flow_row(scene.solver, static_cast<float>(m.density),
                          static_cast<float>(m.viscosity / m.density), k.sound_speed, k.smoothing)

@@ -40,6 +40,8 @@ enum class ExposedArea { Iwasaki2010 };
 // How walls hold the fluid's tangential velocity: only through boundary_viscosity, or no-slip.
 enum class NoSlip { None, Adami2012 };
 const char* name(MaterialKind k);    // "fluid", "solid", "ice", "air"
+// Whether particles of this kind move with the fluid passes and carry their own mass (fluid and air).
+inline bool flows(MaterialKind k) { return k == MaterialKind::Fluid || k == MaterialKind::Air; }
 const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
 const char* name(Eos e);             // "tait", "linear"
 const char* name(PressureSolver p);  // "wcsph", "dfsph"

@@ -91,8 +91,7 @@ SolverConstants derive_constants(const Scene& scene) {
   auto consider = [&](int m) {
     if (m < 0) return;
     const Material& mat = scene.materials[static_cast<std::size_t>(m)];
-    if (mat.kind == MaterialKind::Fluid || mat.kind == MaterialKind::Air)
-      nu = std::max(nu, double(static_cast<float>(mat.viscosity / mat.density)));
+    if (flows(mat.kind)) nu = std::max(nu, double(static_cast<float>(mat.viscosity / mat.density)));
   };
   for (const auto& f : scene.fluids) consider(f.material);
   for (const auto& c : scene.ice) consider(scene.materials[static_cast<std::size_t>(c.material)].partner);

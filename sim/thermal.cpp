@@ -35,7 +35,7 @@ Law law_of(const Scene& scene, int material) {
 }  // namespace
 
 double mass_scale(const Material& m, double rest_density) {
-  return m.kind == MaterialKind::Fluid || m.kind == MaterialKind::Air ? 1.0 : m.density / rest_density;
+  return flows(m.kind) ? 1.0 : m.density / rest_density;
 }
 
 std::vector<MaterialThermal> material_thermal_table(const Scene& scene, double rest_density) {
@@ -120,8 +120,11 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
   plan.walls = wall_heat && scene.heat.wall_coefficient > 0;
   // Air particles carry the air's heat themselves: the ambient model, which stands for the air, is off.
   plan.ambient = scene.heat.ambient_coefficient > 0 && !scene.has_air();
-  plan.adiabatic = std::any_of(scene.materials.begin(), scene.materials.end(),
-                               [](const Material& m) { return m.adiabatic; });
+  // The adiabatic pass only where a solid or the walls are of such a material (not merely declared).
+  auto adiabatic = [&](int m) { return m >= 0 && scene.materials[static_cast<std::size_t>(m)].adiabatic; };
+  plan.adiabatic =
+      adiabatic(scene.wall_material) || std::any_of(scene.solids.begin(), scene.solids.end(),
+                                                    [&](const Solid& s) { return adiabatic(s.material); });
 
   // Temperatures differ by round-off only when each came from the same temperature through a float
   // enthalpy pair: a thousandth of a millikelvin is no difference.

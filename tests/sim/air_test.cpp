@@ -101,6 +101,25 @@ TEST(AirScene, AirParticlesSwitchTheAmbientModelOff) {
   EXPECT_TRUE(plan_heat(without, initial_state(without).particles).ambient);
 }
 
+// The adiabatic pass is built where a solid or the walls are adiabatic, not where such a material is only
+// declared.
+TEST(AirScene, TheAdiabaticPassIsPlannedOnlyForAnAdiabaticSolidInUse) {
+  Json doc = air_box();
+  doc["materials"]["insulation"] = {{"kind", "solid"},
+                                    {"density", 30.0},
+                                    {"conductivity", 0.0},
+                                    {"specific_heat", 1400.0},
+                                    {"adiabatic", true}};
+  doc["solids"][0]["temperature"] = 60.0;  // heat is built
+  const Scene declared = scene_from_json(doc);
+  EXPECT_FALSE(plan_heat(declared, initial_state(declared).particles).adiabatic);
+  doc["domain"]["wall_material"] = "insulation";
+  const Scene walls = scene_from_json(doc);
+  const HeatPlan plan = plan_heat(walls, initial_state(walls).particles);
+  EXPECT_TRUE(plan.build);
+  EXPECT_TRUE(plan.adiabatic);
+}
+
 TEST(AirScene, ErrorsNameTheirPath) {
   Json doc = air_box();
   doc["air"]["material"] = "water";
