@@ -17,7 +17,7 @@ struct ClKeysParams {
   cl_uint open_faces;    // Scene::open_faces
   cl_uint ncells;        // the key of a particle that left through an open side
   cl_uint n;
-  cl_uint pad;
+  cl_uint intakes;  // -DTHAW_INTAKE: nonzero when some particle is taken in by an air dryer
 };
 static_assert(sizeof(ClKeysParams) == 48, "ClKeysParams must match the OpenCL struct's layout");
 

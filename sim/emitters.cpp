@@ -22,58 +22,85 @@ std::vector<Eigen::Vector2i> EmitterStage::disc(double radius, double spacing) {
 
 namespace {
 // N dx^3 / (pi r^2) for a disc of N lattice points.
-double spacing_of(std::size_t points, const Emitter& e, double dx) {
-  return double(points) * dx * dx * dx / e.area();
+double spacing_of(std::size_t points, double radius, double dx) {
+  return double(points) * dx * dx * dx / (M_PI * radius * radius);
 }
 }  // namespace
 
 double EmitterStage::disc_spacing(const Emitter& e, double spacing) {
-  return spacing_of(disc(e.radius, spacing).size(), e, spacing);
+  return spacing_of(disc(e.radius, spacing).size(), e.radius, spacing);
 }
 
 double EmitterStage::particles_per_second(const Emitter& e, double spacing) {
   return double(disc(e.radius, spacing).size()) * e.speed / disc_spacing(e, spacing);
 }
 
+// The disc's N points each carry dx^3 and the discs follow at N dx^3 / A: A v / dx^3 a second.
+double EmitterStage::particles_per_second(const Dryer& d, double spacing) {
+  return d.area() * d.speed / (spacing * spacing * spacing);
+}
+
+bool EmitterStage::needed(const Scene& scene) {
+  return !scene.emitters.empty() || std::any_of(scene.dryers.begin(), scene.dryers.end(),
+                                                [](const Dryer& d) { return d.model == DryerModel::Air; });
+}
+
+std::size_t EmitterStage::lay(const Nozzle& z, double open_for, double& pending, HostParticles& out,
+                              std::uint32_t& next_id) {
+  const std::size_t before = out.size();
+  const double dx = scene_.spacing;
+  pending += z.speed * open_for;
+  const std::vector<Eigen::Vector2i> offsets = disc(z.radius, dx);  // once a step: a client may resize it
+  const double d = spacing_of(offsets.size(), z.radius, dx);
+  if (pending < d) return 0;
+  const Eigen::Vector3d u = z.direction.unitOrthogonal(), w = z.direction.cross(u);
+  const Material& m = scene_.materials[static_cast<std::size_t>(z.material)];
+  const float mass = static_cast<float>(m.density * dx * dx * dx);
+  const double h = enthalpy_at(scene_, z.material, z.temperature);
+  const float h_hi = static_cast<float>(h), h_lo = static_cast<float>(h - double(h_hi));
+  const Eigen::Vector3d v = z.speed * z.direction;
+  while (pending >= d) {
+    pending -= d;
+    // This disc crossed the nozzle when the pending length reached d: it has since gone the rest.
+    const Eigen::Vector3d centre = z.position + pending * z.direction;
+    for (const Eigen::Vector2i& o : offsets) {
+      const Eigen::Vector3d x = centre + dx * (o.x() * u + o.y() * w);
+      out.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
+      out.velocity.push_back({float(v.x()), float(v.y()), float(v.z()), 0.f});
+      out.density.push_back(0.f);
+      out.phase.push_back(static_cast<std::uint8_t>(z.phase));
+      out.material.push_back(static_cast<std::uint8_t>(z.material));
+      out.id.push_back(next_id++);
+      out.enthalpy.push_back({h_hi, h_lo});
+      out.anchored.push_back(0);
+      books_.particles += 1;
+      books_.mass += double(mass);
+      books_.momentum +=
+          double(mass) * Eigen::Vector3d(double(float(v.x())), double(float(v.y())), double(float(v.z())));
+    }
+  }
+  return out.size() - before;
+}
+
 HostParticles EmitterStage::emit(double t, double dt, std::uint32_t& next_id) {
   HostParticles out;
-  const double dx = scene_.spacing;
-  for (std::size_t k = 0; k < scene_.emitters.size(); ++k) {
+  const std::size_t ne = scene_.emitters.size();
+  for (std::size_t k = 0; k < ne; ++k) {
     const Emitter& e = scene_.emitters[k];
     // The part of [t, t + dt] the tap pours in.
     const double stop = e.stop > 0 ? e.stop : std::numeric_limits<double>::infinity();
     const double open_for = std::min(t + dt, stop) - std::max(t, e.start);
     if (!e.open || !(open_for > 0)) continue;
-    pending_[k] += e.speed * open_for;
-    const std::vector<Eigen::Vector2i> offsets = disc(e.radius, dx);  // once a step: a client may resize it
-    const double d = spacing_of(offsets.size(), e, dx);
-    if (pending_[k] < d) continue;
-    const Eigen::Vector3d u = e.direction.unitOrthogonal(), w = e.direction.cross(u);
-    const Material& m = scene_.materials[static_cast<std::size_t>(e.material)];
-    const float mass = static_cast<float>(m.density * dx * dx * dx);
-    const double h = enthalpy_at(scene_, e.material, e.temperature);
-    const float h_hi = static_cast<float>(h), h_lo = static_cast<float>(h - double(h_hi));
-    const Eigen::Vector3d v = e.speed * e.direction;
-    while (pending_[k] >= d) {
-      pending_[k] -= d;
-      // This disc crossed the nozzle when the pending length reached d: it has since gone the rest.
-      const Eigen::Vector3d centre = e.position + pending_[k] * e.direction;
-      for (const Eigen::Vector2i& o : offsets) {
-        const Eigen::Vector3d x = centre + dx * (o.x() * u + o.y() * w);
-        out.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
-        out.velocity.push_back({float(v.x()), float(v.y()), float(v.z()), 0.f});
-        out.density.push_back(0.f);
-        out.phase.push_back(static_cast<std::uint8_t>(Phase::Water));
-        out.material.push_back(static_cast<std::uint8_t>(e.material));
-        out.id.push_back(next_id++);
-        out.enthalpy.push_back({h_hi, h_lo});
-        out.anchored.push_back(0);
-        books_.particles += 1;
-        books_.mass += double(mass);
-        books_.momentum +=
-            double(mass) * Eigen::Vector3d(double(float(v.x())), double(float(v.y())), double(float(v.z())));
-      }
-    }
+    lay({e.position, e.direction, e.radius, e.speed, e.temperature, e.material, Phase::Water}, open_for,
+        pending_[k], out, next_id);
+  }
+  for (std::size_t k = 0; k < scene_.dryers.size(); ++k) {
+    const Dryer& d = scene_.dryers[k];
+    if (d.model != DryerModel::Air || !d.on || !(d.speed > 0) || !(dt > 0)) continue;
+    // Laid at the back of the dryer's pipe, which carries them to the exit at its speed (grid.cl).
+    owed_[k] += double(lay({d.position - pipe_length(scene_) * d.direction, d.direction,
+                            0.5 * d.nozzle_diameter, d.speed, d.temperature, scene_.air.material, Phase::Air},
+                           dt, pending_[ne + k], out, next_id));
   }
   return out;
 }
@@ -83,19 +110,27 @@ std::vector<double> EmitterStage::save(const Saved& solver) const {
                            books_.momentum.y(),      books_.momentum.z(), double(solver.next_id),
                            double(solver.capacity)};
   v.insert(v.end(), pending_.begin(), pending_.end());
+  v.insert(v.end(), owed_.begin(), owed_.end());
   return v;
 }
 
 EmitterStage::Saved EmitterStage::restore(const std::vector<double>& v) {
   if (v.empty()) return {};
-  if (v.size() != 7 + pending_.size())
+  // States written before air dryers kept the emitters' pending lengths only: the dryers' start at 0.
+  const std::size_t with_emitters = 7 + scene_.emitters.size();
+  const std::size_t full = 7 + pending_.size() + owed_.size();
+  if (v.size() != full && v.size() != with_emitters)
     throw Error("state: the inflow section has " + std::to_string(v.size()) + " entries, expected " +
-                std::to_string(7 + pending_.size()) + " for a scene with " + std::to_string(pending_.size()) +
-                " emitters");
+                std::to_string(full) + " for a scene with " + std::to_string(scene_.emitters.size()) +
+                " emitters and " + std::to_string(scene_.dryers.size()) + " dryers");
   books_.particles = static_cast<std::uint64_t>(v[0]);
   books_.mass = v[1];
   books_.momentum = {v[2], v[3], v[4]};
-  std::copy(v.begin() + 7, v.end(), pending_.begin());
+  std::fill(pending_.begin(), pending_.end(), 0.0);
+  std::fill(owed_.begin(), owed_.end(), 0.0);
+  std::copy(v.begin() + 7, v.begin() + std::ptrdiff_t(std::min(v.size(), 7 + pending_.size())),
+            pending_.begin());
+  if (v.size() == full) std::copy(v.end() - std::ptrdiff_t(owed_.size()), v.end(), owed_.begin());
   return {static_cast<std::uint64_t>(v[5]), static_cast<std::uint64_t>(v[6])};
 }
 

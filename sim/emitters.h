@@ -10,6 +10,18 @@
 // Capacity: emitted particles go into the store's spare capacity (sim/stage.h, ParticleLayout); the
 // solver grows the capacity when it runs out (Solver::step). What came in is booked like what leaves
 // through open sides: particles, mass, momentum here, enthalpy in the energy budget.
+//
+// Air dryers (dryers[].model "air", Domaradzki & Martyn sec. 7's dryer made an emitter) are nozzles of the
+// same kind that lay air particles of the scene's air material at the dryer's temperature, while on. Unlike
+// a tap, a dryer blows into air that is already there, so it has a pipe and a housing (grid.cl,
+// intake_flags): the discs are laid at the back of a pipe one kernel support long behind the exit, whose
+// own air moves out at the exit speed, so the air leaving the exit is evenly spaced and has air behind it
+// (laid at the exit itself, with nothing behind, the jet's first spacings were 10-40 % under-dense, room
+// air mixed into it and the jet carried 25 % less than it blew a diameter on); the slow room air that
+// drifts into the pipe is taken in (removed, booked with the outflow), and the housing around and behind
+// the pipe takes the room's air in as long as the dryer owes particles: blown and not yet taken in. So a
+// dryer draws room air in as a real one does, and over time takes in as many particles as it blows: a
+// closed room keeps its air (tests/sim/air_test.cpp).
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
@@ -35,16 +47,32 @@ class EmitterStage {
   static double disc_spacing(const Emitter& e, double spacing);
   // Particles an emitter pours per second while open [1/s].
   static double particles_per_second(const Emitter& e, double spacing);
+  // Particles an air dryer blows per second while on [1/s].
+  static double particles_per_second(const Dryer& d, double spacing);
+  // An air dryer's geometry (see above): its pipe's length [m], one kernel support (so the air leaving
+  // the exit has air behind it), and in spacings the depth of the mouth in front of the exit (where slow
+  // room air is taken in) and of the body behind the pipe.
+  static double pipe_length(const Scene& scene) { return scene.solver.support_ratio * scene.spacing; }
+  static constexpr double mouth_depth = 1.5, body_depth = 3.0;
 
-  explicit EmitterStage(const Scene& scene) : scene_(scene), pending_(scene.emitters.size(), 0.0) {}
+  // Emitters first, then the air dryers, in the scene's order.
+  explicit EmitterStage(const Scene& scene)
+      : scene_(scene),
+        pending_(scene.emitters.size() + scene.dryers.size(), 0.0),
+        owed_(scene.dryers.size(), 0.0) {}
+  // Whether the scene has anything this stage pours: an emitter or an air dryer.
+  static bool needed(const Scene& scene);
 
-  // The particles the emitters pour between t and t + dt (each emitter open within [start, stop)),
-  // with ids from next_id on (advanced), in the order of the emitters and, for each, oldest disc first;
+  // The particles the emitters pour between t and t + dt (each emitter open within [start, stop)) and the
+  // air dryers blow (each while on), with ids from next_id on (advanced), in the order of the emitters
+  // then the dryers and, for each, oldest disc first;
   // books their particles, mass and momentum (the solver books their enthalpy in the energy budget).
   // Empty when nothing is due.
   HostParticles emit(double t, double dt, std::uint32_t& next_id);
 
   const InflowBooks& books() const { return books_; }
+  // Per dryer, the particles it has blown and not yet taken in (NeighbourGrid::build takes them in).
+  std::vector<double>& owed() { return owed_; }
 
   // The stage's state for state files: the books, each emitter's pending length, and the run's next
   // particle id and capacity (kept by the solver, saved here so a resumed run lays out and numbers its
@@ -56,8 +84,19 @@ class EmitterStage {
   Saved restore(const std::vector<double>& v);
 
  private:
+  // One nozzle's share of emit(): `pending` advanced by speed * open_for, discs laid while it reaches d.
+  struct Nozzle {
+    Eigen::Vector3d position, direction;  // where discs are laid (an air dryer's: its pipe's back)
+    double radius, speed, temperature;
+    int material;
+    Phase phase;
+  };
+  // Returns the particles laid.
+  std::size_t lay(const Nozzle& z, double open_for, double& pending, HostParticles& out,
+                  std::uint32_t& next_id);
+
   const Scene& scene_;  // the solver's, whose emitters a client may change between steps
-  std::vector<double> pending_;
+  std::vector<double> pending_, owed_;
   InflowBooks books_;
 };
 

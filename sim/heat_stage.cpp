@@ -89,7 +89,7 @@ double HeatStage::max_dt() const {
   double dt = std::min(diffusion_dt_, wall_dt_);
   double h_air = plan_.ambient ? scene_.heat.ambient_coefficient : 0.0;
   for (const Dryer& d : scene_.dryers)
-    if (d.on && d.speed > 0)
+    if (d.model == DryerModel::Cone && d.on && d.speed > 0)
       h_air += dryer::dryer_coefficient(static_cast<float>(d.nozzle_diameter)) * std::sqrt(d.speed);
   if (h_air > 0) dt = std::min(dt, 0.5 * exposed_capacity_ / (scene_.heat.time_scale * h_air));
   return dt;

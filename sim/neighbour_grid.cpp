@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "sim/cl_launch.h"
+#include "sim/emitters.h"
 #include "sim/error.h"
 
 namespace thaw {
@@ -58,8 +59,10 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
     info_.origin[a] = static_cast<float>(scene.domain.min[a]);
   }
   ncells_ = static_cast<std::uint32_t>(double(info_.nx) * info_.ny * info_.nz);
-  // With open sides the keys run to ncells: particles that left sort behind every cell.
-  const std::uint32_t max_key = scene.open_faces ? ncells_ : ncells_ - 1;
+  intake_ = std::any_of(scene.dryers.begin(), scene.dryers.end(),
+                        [](const Dryer& d) { return d.model == DryerModel::Air; });
+  // With open sides or intakes the keys run to ncells: particles that left sort behind every cell.
+  const std::uint32_t max_key = scene.open_faces || intake_ ? ncells_ : ncells_ - 1;
   int bits = 1;
   while (bits < 32 && max_key >> bits) ++bits;
   // The fewest radix passes of at most 11 bits, the key's bits spread evenly over them (17 bits: two
@@ -67,10 +70,15 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   sort_passes_ = static_cast<std::uint32_t>((bits + 10) / 11);
   radix_bits_ = static_cast<std::uint32_t>((bits + int(sort_passes_) - 1) / int(sort_passes_));
 
-  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "grid.cl"},
-                                build_options + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_) +
-                                    " -DTHAW_SCAN_CHUNK=" + std::to_string(kScanChunk));
+  const auto program =
+      cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "grid.cl"},
+               build_options + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_) +
+                   " -DTHAW_SCAN_CHUNK=" + std::to_string(kScanChunk) + (intake_ ? " -DTHAW_INTAKE" : ""));
   k_cell_keys_ = cl::Kernel(program, "cell_keys");
+  if (intake_) {
+    k_intake_flags_ = cl::Kernel(program, "intake_flags");
+    k_pipe_drive_ = cl::Kernel(program, "pipe_drive");
+  }
   k_hist_ = cl::Kernel(program, "radix_histogram");
   k_chunk_counts_ = cl::Kernel(program, "radix_chunk_counts");
   k_scan_chunks_ = cl::Kernel(program, "radix_scan_chunks");
@@ -92,12 +100,17 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   chunks_ = buf((std::size_t(1) << radix_bits_) *
                 ((std::max<cl_uint>(layout.max_tiles, 1) + kScanChunk - 1) / kScanChunk) * 4);
   cell_start_ = buf((std::size_t(ncells_) + 1) * 4);
+  if (intake_) {
+    intakes_ = buf(scene.dryers.size() * 4 * 16);
+    take_ = buf(n);
+  }
   soa_ = buf(std::size_t(layout.stride) * 7 * 4);
   // The padding past the last particle is read by masked lanes only; keep it finite anyway.
   cl.queue().enqueueFillBuffer(soa_, 0.0f, 0, std::size_t(layout.stride) * 7 * 4);
 }
 
-std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped) {
+std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped,
+                                 std::vector<double>* owed) {
   if (layout_.n == 0) return 0;
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(layout_.n);
@@ -110,8 +123,52 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
   P.open_faces = static_cast<cl_uint>(scene_.open_faces);
   P.ncells = ncells_;
   P.n = n;
-  set_args(k_cell_keys_, store[f.position], store[f.velocity], store[f.phase], keys_[0], order_[0], clamped,
-           g, P);
+  if (intake_) {
+    // The blowing dryers' intakes as they are now (a client may aim or switch them between steps).
+    std::vector<cl_float4> in;
+    const double dx = scene_.spacing;
+    for (std::size_t k = 0; k < scene_.dryers.size(); ++k) {
+      const Dryer& dr = scene_.dryers[k];
+      if (dr.model != DryerModel::Air || !dr.on || !(dr.speed > 0)) continue;
+      const double r = 0.5 * dr.nozzle_diameter + dx, pipe = 0.5 * dr.nozzle_diameter + 0.5 * dx;
+      const Eigen::Vector3d x = dr.position;
+      const Eigen::Vector3d& u = dr.direction;
+      in.push_back({{float(x.x()), float(x.y()), float(x.z()), float(r * r)}});
+      in.push_back({{float(u.x()), float(u.y()), float(u.z()), float(EmitterStage::pipe_length(scene_))}});
+      in.push_back(
+          {{float(EmitterStage::mouth_depth * dx), float(0.5 * dr.speed), float(k), float(pipe * pipe)}});
+      in.push_back({{float(dr.speed), float(EmitterStage::body_depth * dx), 0.f, 0.f}});
+    }
+    blowing_ = static_cast<cl_uint>(in.size() / 4);
+    if (!in.empty()) q.enqueueWriteBuffer(intakes_, CL_TRUE, 0, in.size() * 16, in.data());
+    if (!in.empty() && owed) {
+      set_args(k_intake_flags_, store[f.position], store[f.velocity], store[f.phase], take_, intakes_,
+               static_cast<cl_uint>(in.size() / 4), n);
+      launch(q, k_intake_flags_, layout_.n);
+      // Which to take in, in index order (the sort's, so a rerun chooses the same): every slow particle
+      // in a pipe (the discs run into it), one in a body while its dryer owes.
+      take_host_.resize(layout_.n);
+      q.enqueueReadBuffer(take_, CL_TRUE, 0, layout_.n, take_host_.data());
+      bool changed = false;
+      for (std::uint8_t& t : take_host_) {
+        if (!t) continue;
+        double& debt = (*owed)[std::size_t((t - 1) / 2)];
+        if (t % 2 == 1 || debt >= 1.0) {
+          debt -= 1.0;
+          P.intakes = 1;
+        } else {
+          t = 0;
+          changed = true;
+        }
+      }
+      if (changed) q.enqueueWriteBuffer(take_, CL_TRUE, 0, layout_.n, take_host_.data());
+    }
+    set_args(k_cell_keys_, store[f.position], store[f.velocity], store[f.phase], keys_[0], order_[0], clamped,
+             g, P, take_);
+  } else {
+    set_args(k_cell_keys_, store[f.position], store[f.velocity], store[f.phase], keys_[0], order_[0], clamped,
+             g, P);
+  }
   launch(q, k_cell_keys_, layout_.n);
 
   for (std::uint32_t pass = 0; pass < sort_passes_; ++pass) {
@@ -140,11 +197,18 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
 
   set_args(k_starts_, keys, cell_start_, n, ncells_);
   launch(q, k_starts_, layout_.n + 1);
-  if (!scene_.open_faces) return layout_.n;
+  if (!scene_.open_faces && !intake_) return layout_.n;
   // cell_start[ncells] is the first particle that left (or n): those behind it are removed.
   cl_uint kept = 0;
   q.enqueueReadBuffer(cell_start_, CL_TRUE, std::size_t(ncells_) * 4, 4, &kept);
   return kept;
+}
+
+void NeighbourGrid::drive_pipes(ParticleStore& store, const CoreFields& f) {
+  if (!intake_ || !blowing_ || layout_.n == 0) return;
+  set_args(k_pipe_drive_, store[f.position], store[f.velocity], store[f.phase], intakes_, blowing_,
+           static_cast<cl_uint>(layout_.n));
+  launch(cl_.queue(), k_pipe_drive_, layout_.n);
 }
 
 std::vector<std::uint32_t> NeighbourGrid::cell_starts() const {

@@ -39,8 +39,16 @@ class NeighbourGrid {
   // Sorts the particles by cell: keys (clamping particles that left the domain through a closed side
   // back into it and counting them in `clamped`), the radix sort, the reorder of every field of `store`,
   // the cell ranges. Returns how many particles are still in: those that left through an open side
-  // (Scene::open_faces) are sorted behind them, in no cell, for the caller to remove.
-  std::size_t build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped);
+  // (Scene::open_faces) or that an air dryer took in (sim/emitters.h) are sorted behind them, in no cell,
+  // for the caller to remove.
+  // `owed` (scenes with air dryers: EmitterStage::owed()) holds, per dryer, the particles it has blown
+  // and not yet taken in: the air in a dryer's mouth is always taken in, the air in its body while owed.
+  std::size_t build(ParticleStore& store, const CoreFields& f, const cl::Buffer& clamped,
+                    std::vector<double>* owed = nullptr);
+
+  // Air dryers: their pipes' air set moving out at the exit speed (grid.cl, pipe_drive), with the
+  // dryers as the last build() saw them. Nothing without blowing air dryers.
+  void drive_pipes(ParticleStore& store, const CoreFields& f);
 
   NeighbourView view() const { return {soa_, layout_.stride, cell_start_, cl_grid(info_)}; }
   const GridInfo& info() const { return info_; }
@@ -53,9 +61,13 @@ class NeighbourGrid {
   const Scene& scene_;
   const ParticleLayout& layout_;
   GridInfo info_;
+  bool intake_ = false;  // the scene has air dryers: the key pass takes in what their intakes hold
+  std::vector<std::uint8_t> take_host_;
   std::uint32_t ncells_ = 0, sort_passes_ = 0, radix_bits_ = 8;
-  cl::Kernel k_cell_keys_, k_hist_, k_chunk_counts_, k_scan_chunks_, k_scan_tiles_, k_scatter_, k_starts_;
-  cl::Buffer keys_[2], order_[2], hist_, totals_, chunks_, cell_start_, soa_;
+  cl_uint blowing_ = 0;  // air dryers blowing at the last build()
+  cl::Kernel k_pipe_drive_, k_intake_flags_, k_cell_keys_, k_hist_, k_chunk_counts_, k_scan_chunks_,
+      k_scan_tiles_, k_scatter_, k_starts_;
+  cl::Buffer keys_[2], order_[2], hist_, totals_, chunks_, cell_start_, soa_, intakes_, take_;
 };
 
 }  // namespace thaw

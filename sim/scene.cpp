@@ -47,6 +47,7 @@ const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "a
 const char* name(ExposedArea) { return "iwasaki2010"; }
 const char* name(DfsphBoundary b) { return b == DfsphBoundary::Akinci2012 ? "akinci2012" : "adami2012"; }
 const char* name(NoSlip n) { return n == NoSlip::Adami2012 ? "adami2012" : "none"; }
+const char* name(DryerModel m) { return m == DryerModel::Air ? "air" : "cone"; }
 
 namespace {
 // A choice the schema has already checked, as its enum.
@@ -482,13 +483,10 @@ Scene convert_and_check(Json doc, const std::string& folder) {
 
   for (std::size_t i = 0; i < doc["lamps"].size(); ++i)
     s.lamps.push_back(lamp_from_json(doc["lamps"][i], join_path("lamps", i)));
-  for (std::size_t i = 0; i < doc["dryers"].size(); ++i)
+  for (std::size_t i = 0; i < doc["dryers"].size(); ++i) {
     s.dryers.push_back(dryer_from_json(doc["dryers"][i], join_path("dryers", i)));
-  if (s.has_air() && !s.dryers.empty())
-    throw SceneError(
-        "dryers[0]",
-        "the cone dryer heats ice and water where no air particles are; with `air` it would heat "
-        "them through the air (counted twice): remove the dryer or the air");
+    check_dryer(s.dryers.back(), s, join_path("dryers", i));
+  }
   for (std::size_t i = 0; i < doc["emitters"].size(); ++i) {
     Json e = doc["emitters"][i];
     if (!e.contains("temperature")) e["temperature"] = s.heat.ambient_temperature;
@@ -585,7 +583,8 @@ Json v(const Eigen::Vector3d& x) { return Json::array({x.x(), x.y(), x.z()}); }
 }  // namespace
 
 Json to_json(const Dryer& d) {
-  return {{"on", d.on},
+  return {{"model", name(d.model)},
+          {"on", d.on},
           {"position", v(d.position)},
           {"direction", v(d.direction)},
           {"half_angle", d.half_angle},
@@ -608,6 +607,7 @@ Json to_json(const Lamp& l) {
 
 Dryer dryer_from_json(const Json& j, const std::string& path) {
   Dryer d;
+  d.model = choice_of<DryerModel>(j["model"], {DryerModel::Cone, DryerModel::Air});
   d.on = j["on"].get<bool>();
   d.position = vec(j["position"]);
   d.direction = unit_direction(vec(j["direction"]), path + ".direction");
@@ -633,6 +633,7 @@ Lamp lamp_from_json(const Json& j, const std::string& path) {
 }
 
 double Emitter::area() const { return M_PI * radius * radius; }
+double Dryer::area() const { return 0.25 * M_PI * nozzle_diameter * nozzle_diameter; }
 
 Json to_json(const Emitter& e, const std::vector<Material>& materials) {
   return {{"open", e.open},
@@ -701,6 +702,32 @@ void check_emitter(const Emitter& e, const Scene& scene, const std::string& path
     throw SceneError(path + ".position", "[" + format_number(e.position.x()) + ", " +
                                              format_number(e.position.y()) + ", " +
                                              format_number(e.position.z()) + "] lies outside the domain");
+}
+
+void check_dryer(const Dryer& d, const Scene& scene, const std::string& path) {
+  if (d.model == DryerModel::Cone) {
+    if (scene.has_air())
+      throw SceneError(path + ".model",
+                       "the cone dryer heats ice and water where no air particles are; with `air` it would "
+                       "heat them through the air (counted twice): set \"model\": \"air\" to blow the air");
+    return;
+  }
+  if (!scene.has_air())
+    throw SceneError(
+        path + ".model",
+        "an air dryer blows the scene's air particles, and this scene has none: add `air`, or use "
+        "\"model\": \"cone\"");
+  if (d.nozzle_diameter < 2.0 * scene.spacing * (1.0 - 1e-9))
+    throw SceneError(path + ".nozzle_diameter", format_number(d.nozzle_diameter) +
+                                                    " m is less than two particle spacings (" +
+                                                    format_number(2.0 * scene.spacing) +
+                                                    " m): an air dryer's nozzle must be at least "
+                                                    "two particles wide");
+  const Box& b = scene.domain;
+  if ((d.position.array() < b.min.array()).any() || (d.position.array() > b.max.array()).any())
+    throw SceneError(path + ".position", "[" + format_number(d.position.x()) + ", " +
+                                             format_number(d.position.y()) + ", " +
+                                             format_number(d.position.z()) + "] lies outside the domain");
 }
 
 Eigen::Vector3d unit_direction(const Eigen::Vector3d& v, const std::string& path) {

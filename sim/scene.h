@@ -39,6 +39,9 @@ enum class DfsphBoundary { Adami2012, Akinci2012 };
 enum class ExposedArea { Iwasaki2010 };
 // How walls hold the fluid's tangential velocity: only through boundary_viscosity, or no-slip.
 enum class NoSlip { None, Adami2012 };
+// What a dryer is: an analytic cone of warm air that heats exposed ice and water (scenes without air
+// particles), or a nozzle that blows air particles (scenes with `air`; sim/emitters.h).
+enum class DryerModel { Cone, Air };
 const char* name(MaterialKind k);    // "fluid", "solid", "ice", "air"
 // Whether particles of this kind move with the fluid passes and carry their own mass (fluid and air).
 inline bool flows(MaterialKind k) { return k == MaterialKind::Fluid || k == MaterialKind::Air; }
@@ -49,6 +52,7 @@ const char* name(BoundaryVolume b);  // "lattice", "akinci"
 const char* name(ExposedArea a);     // "iwasaki2010" (also the heat pass's function suffix)
 const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
 const char* name(NoSlip n);          // "none", "adami2012"
+const char* name(DryerModel m);      // "cone", "air"
 
 struct Material {
   std::string name;
@@ -125,6 +129,7 @@ struct Lamp {
 };
 
 struct Dryer {
+  DryerModel model = DryerModel::Cone;
   bool on = true;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d direction = -Eigen::Vector3d::UnitZ();  // unit
@@ -133,6 +138,8 @@ struct Dryer {
   double temperature = 60.0;                              // air at the nozzle [°C]
   double speed = 10.0;                                    // air at the nozzle [m/s]
   double nozzle_diameter = 0.04;                          // [m]
+  // model air: the nozzle's area pi d^2 / 4 [m^2]
+  double area() const;
 };
 
 // A nozzle that pours fluid (Iwasaki et al. 2010, Fig. 7): layers of particles on the disc of the nozzle,
@@ -248,6 +255,10 @@ Emitter emitter_from_json(const Json& j, const std::string& path, const std::vec
 // PATH.radius or PATH.position).
 struct Scene;
 void check_emitter(const Emitter& e, const Scene& scene, const std::string& path);
+// What a dryer needs of the scene: a cone dryer, no air particles (they would carry its heat twice); an
+// air dryer, the scene's air to blow, a nozzle at least two spacings wide and inside the domain (SceneError
+// at PATH.model, PATH.nozzle_diameter or PATH.position).
+void check_dryer(const Dryer& d, const Scene& scene, const std::string& path);
 
 // `v` scaled to unit length; `path` names it in the SceneError when it is not a vector of moderate size:
 // zero, or so long or so short that its squared length overflows or underflows a double. The protocol

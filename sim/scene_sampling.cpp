@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "sim/emitters.h"
 #include "sim/error.h"
 #include "sim/geometry/voxelize.h"
 #include "sim/solver.h"
@@ -171,6 +172,19 @@ HostParticles sample_scene(const Scene& scene) {
     for (const auto& s : scene.solids) drop_inside(points, s);
     for (const auto& c : scene.ice) drop_inside(points, c.shape);
     for (const auto& f : scene.fluids) drop_inside(points, Shape::box(f.box.min, f.box.max));
+    // An air dryer's pipe holds its own air, laid as it blows (sim/emitters.h): room air there would be
+    // taken in at the first step.
+    for (const Dryer& d : scene.dryers) {
+      if (d.model != DryerModel::Air) continue;
+      const double pipe = EmitterStage::pipe_length(scene), r = 0.5 * d.nozzle_diameter + 0.5 * dx;
+      std::vector<std::uint8_t> in_pipe(points.size());
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const Vec3 x = points[i] - d.position;
+        const double along = x.dot(d.direction);
+        in_pipe[i] = along >= -pipe && along < 0 && (x - along * d.direction).squaredNorm() < r * r;
+      }
+      drop(points, in_pipe);
+    }
     if (points.empty())
       throw SceneError("air", "its region holds no particle outside the solids, ice and fluid blocks");
     for (const Vec3& x : points) add(p, x, Vec3::Zero(), mass, Phase::Air, a.material, h);

@@ -510,16 +510,21 @@ const Field& scene_schema() {
           array_of(
               "dryers",
               {
+                  choice("model", {"cone", "air"},
+                         "cone: an analytic cone of warm air heats the exposed ice and water inside it "
+                         "(scenes without air particles); air: the nozzle blows air particles at `speed` "
+                         "and `temperature` and draws in the air behind it (scenes with `air`)")
+                      .def("cone"),
                   flag("on", "Blowing").def(true).live_in_place(),
                   vec3("position", "Nozzle position").in("m").live_in_place(),
                   vec3("direction", "Where the air blows; need not be unit length").live_in_place(),
-                  number("half_angle", "Half-angle of the cone of warm air")
+                  number("half_angle", "Half-angle of the cone of warm air (model cone)")
                       .in("deg")
                       .def(15.0)
                       .above(0)
                       .at_most(60)
                       .live_in_place(),
-                  number("reach", "Length of the cone; nothing beyond it feels the dryer")
+                  number("reach", "Length of the cone; nothing beyond it feels the dryer (model cone)")
                       .in("m")
                       .def(0.3)
                       .above(0)
@@ -538,15 +543,16 @@ const Field& scene_schema() {
                       .at_most(100)
                       .live_in_place(),
                   number("nozzle_diameter",
-                         "Sets the jet's core length (6 diameters) and the length scale of "
-                         "its heat-transfer coefficient")
+                         "cone: sets the jet's core length (6 diameters) and the length scale of its "
+                         "heat-transfer coefficient; air: the nozzle the particles leave through")
                       .in("m")
                       .def(0.04)
                       .above(0)
                       .at_most(1),
               },
-              "Hair dryers without air particles: a cone of warm, fast air that heats the exposed surface "
-              "inside it (sim/kernels/dryer_model.h has the model).")
+              "Hair dryers: without air particles a cone of warm, fast air that heats the exposed surface "
+              "inside it (sim/kernels/dryer_model.h has the model); with `air`, a nozzle that blows warm air "
+              "particles (model air, sim/emitters.h).")
               .def(Json::array()),
           array_of(
               "emitters",

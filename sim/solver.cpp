@@ -120,6 +120,8 @@ SolverConstants derive_constants(const Scene& scene) {
     }
     for (const auto& f : scene.fluids) v_ref = std::max(v_ref, f.velocity.norm());
     for (const auto& e : scene.emitters) v_ref = std::max(v_ref, e.speed);
+    for (const auto& d : scene.dryers)
+      if (d.model == DryerModel::Air) v_ref = std::max(v_ref, d.speed);
     v_ref = std::max(v_ref, 0.1);  // a still fluid in zero gravity still needs a finite stiffness
   }
   k.sound_speed = static_cast<float>(s.speed_of_sound > 0 ? s.speed_of_sound : s.sound_speed_factor * v_ref);
@@ -259,9 +261,11 @@ std::unique_ptr<RigidIce> make_rigid_ice(ClRuntime& cl, ParticleStore& store, co
 
 // Room for the emitters' first second beside the particles there are; the solver grows it later.
 std::size_t first_capacity(const Scene& scene, std::size_t n) {
-  if (scene.emitters.empty()) return n;
+  if (!EmitterStage::needed(scene)) return n;
   double per_second = 0;
   for (const Emitter& e : scene.emitters) per_second += EmitterStage::particles_per_second(e, scene.spacing);
+  for (const Dryer& d : scene.dryers)
+    if (d.model == DryerModel::Air) per_second += EmitterStage::particles_per_second(d, scene.spacing);
   return n + std::max<std::size_t>(1024, static_cast<std::size_t>(std::ceil(per_second)));
 }
 
@@ -269,7 +273,7 @@ std::size_t first_capacity(const Scene& scene, std::size_t n) {
 
 Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     : cl_(cl), scene_(scene), k_(derive_constants(scene)), store_(cl) {
-  if (!scene_.emitters.empty()) emitters_ = std::make_unique<EmitterStage>(scene_);
+  if (EmitterStage::needed(scene_)) emitters_ = std::make_unique<EmitterStage>(scene_);
   build(st, 0);
 }
 
@@ -372,8 +376,9 @@ void Solver::timed(Stage s, F&& f) {
   timers_.add(s, seconds_since(t0));
 }
 
-void Solver::build_grid() {
-  const std::size_t kept = grid_->build(store_, f_, clamped_);
+void Solver::build_grid(bool intake) {
+  const std::size_t kept =
+      grid_->build(store_, f_, clamped_, intake && emitters_ ? &emitters_->owed() : nullptr);
   if (kept < n_) remove_particles_from(kept);
   grid_built_ = true;
 }
@@ -448,7 +453,7 @@ void Solver::compute_boundary_psi(const std::string& opts) {
   const auto boundary = cl_.build(with_prelude({"boundary.cl"}), opts);
   cl::Kernel psi(boundary, "boundary_psi"), set_mass(boundary, "set_mass");
   cl::Buffer scratch(cl_.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(n_, 1) * 4);
-  build_grid();
+  build_grid(false);
   auto& q = cl_.queue();
   const auto n = static_cast<cl_uint>(n_);
   const ClGrid g = cl_grid(grid_->info());
@@ -604,7 +609,11 @@ void Solver::step() {
     timed(Stage::Heat, [&] { compute_heat(dt); });
   }
   if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
-  if (flow) timed(Stage::Integrate, [&] { integrate(dt); });
+  if (flow)
+    timed(Stage::Integrate, [&] {
+      grid_->drive_pipes(store_, f_);  // (its v += a dt then moves the pipes' air a little off)
+      integrate(dt);
+    });
   time_ += dt;
   dt_ = dt;
   ++steps_;
@@ -647,7 +656,10 @@ void Solver::step_dfsph() {
                               b.grid, b.n, b.ids});
     });
   if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
-  timed(Stage::Integrate, [&] { dfsph_->drift(dt); });
+  timed(Stage::Integrate, [&] {
+    grid_->drive_pipes(store_, f_);
+    dfsph_->drift(dt);
+  });
   time_ += dt;
   dt_ = dt;
   ++steps_;
@@ -659,8 +671,9 @@ void Solver::hold_ice(bool held) {
 }
 
 void Solver::warm_up() {
-  // A sort of sorted keys is the identity and dt = 0 leaves x and v unchanged, so this changes no state.
-  build_grid();
+  // A sort of sorted keys is the identity and dt = 0 leaves x and v unchanged, so this changes no state
+  // (the air dryers take nothing in).
+  build_grid(false);
   // The first labelling is due before the first step anyway, at these same positions.
   if (rigid_) rigid_->relabel_if_due(buffers(), steps_);
   compute_density();
@@ -680,7 +693,11 @@ void Solver::set_dryer(std::size_t index, const Dryer& d) {
   const std::string path = "dryers[" + std::to_string(index) + "]";
   Json j = to_json(d);
   validate(j, *find_field(scene_schema(), "dryers[0]"), path);
-  scene_.dryers[index] = dryer_from_json(j, path);
+  Dryer checked = dryer_from_json(j, path);
+  check_dryer(checked, scene_, path);
+  if (checked.model != scene_.dryers[index].model)
+    throw Error(path + ".model: a dryer's model is fixed while the scene runs (it decides the stages built)");
+  scene_.dryers[index] = checked;
   if (heat_) heat_->dryers_changed();
 }
 

@@ -140,7 +140,8 @@ class Solver {
   // Stage entry points, exposed for benchmarks and tests; step() is their composition.
   // build_grid() also writes the copies that compute_density() and compute_forces() read: call it
   // first after anything that moves particles.
-  void build_grid();
+  // intake false: the air dryers take nothing in (a warm-up changes no state).
+  void build_grid(bool intake = true);
   void compute_density();
   void compute_forces();
   double choose_time_step();

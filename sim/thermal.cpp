@@ -113,7 +113,9 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
     plan.reason = "heat.enabled is false";
     return plan;
   }
-  plan.dryers = !scene.dryers.empty();
+  // Cone dryers only: an air dryer's heat comes in with the air it blows (booked as inflow).
+  plan.dryers = std::any_of(scene.dryers.begin(), scene.dryers.end(),
+                            [](const Dryer& d) { return d.model == DryerModel::Cone; });
   plan.lamps = !scene.lamps.empty();
   const bool wall_heat = std::any_of(scene.materials.begin(), scene.materials.end(),
                                      [](const Material& m) { return m.wall_heat; });
@@ -132,14 +134,20 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
   // What emitters pour counts as though it were there already (a closed tap may open).
   std::vector<float> T = temperatures_of(p, scene);
   for (const Emitter& e : scene.emitters) T.push_back(static_cast<float>(e.temperature));
+  for (const Dryer& d : scene.dryers)
+    if (d.model == DryerModel::Air) T.push_back(static_cast<float>(d.temperature));
   const auto [lo, hi] = std::minmax_element(T.begin(), T.end());
   const bool spread = !T.empty() && double(*hi) - double(*lo) > kSame;
   auto differs = [&](double outside) {
     return !T.empty() && (std::abs(double(*lo) - outside) > kSame || std::abs(double(*hi) - outside) > kSame);
   };
   std::ostringstream why;
+  const bool air_dryers = std::any_of(scene.dryers.begin(), scene.dryers.end(),
+                                      [](const Dryer& d) { return d.model == DryerModel::Air; });
   if (plan.dryers) {
     why << "the scene has dryers";
+  } else if (air_dryers) {
+    why << "the scene has an air dryer (its temperature can be set live)";
   } else if (plan.lamps) {
     why << "the scene has lamps";
   } else if (spread) {

@@ -18,6 +18,7 @@
 #include "sim/cl_runtime.h"
 #include "sim/error.h"
 #include "sim/scene.h"
+#include "sim/state_file.h"
 
 namespace thaw::testing {
 
@@ -67,6 +68,12 @@ inline std::string read_file_bytes(const fs::path& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// The bytes of `state` as a state file (written to dir / name): two runs compared bit for bit.
+inline std::string state_file_bytes(const SimState& state, const TempDir& dir, const std::string& name) {
+  write_state_file(dir / name, state);
+  return read_file_bytes(dir / name);
 }
 
 inline void write_text(const fs::path& path, const std::string& text) {

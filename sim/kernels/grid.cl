@@ -7,14 +7,86 @@
  * domain removed, and counted in `clamped`), unless the side is open (bit 2a of open_faces for the lower
  * side of axis a, 2a + 1 for the upper): then it has left, and its key is `ncells`, past every cell, so
  * the sort moves it behind all the others where the solver removes it. */
+/* Air dryers (-DTHAW_INTAKE; sim/emitters.h). Per blowing dryer k, four float4: (exit centre, (r + dx)^2),
+ * (unit direction u, pipe length P), (mouth depth M, half the exit speed, k, (r + dx/2)^2), (exit speed,
+ * body depth B, 0, 0). Along the axis s = (x - centre).u, across it the distance rho; only air particles:
+ *   pipe  -P <= s < 0, rho < r + dx/2: the nozzle's own air, laid in discs at its back, moves out at
+ *         the exit speed (pipe_drive sets it before each step's drift, so the discs reach the exit
+ *         evenly spaced and with air behind them, as in a real nozzle); air there that does not move so
+ *         came in from outside and is taken in (flag 2k + 1): left there (if it moved out at half the
+ *         exit speed) the jet carried 7 % more momentum than the nozzle gave it;
+ *   mouth 0 <= s < M, rho < r + dx/2: air slower than half the exit speed is taken in (2k + 1): the jet
+ *         leaves into room air at the room's pressure (room air left there, the jet pushed it ahead,
+ *         the pressure at the exit rose, and the jet carried 9 % more momentum than the nozzle gave it);
+ *   body  the rest of -P - B <= s < 0, rho < r + dx: the dryer's housing, where it draws the room's air
+ *         in (2k + 2), taken while the dryer owes particles (the host chooses, NeighbourGrid::build).
+ * cell_keys removes those whose flag the host leaves nonzero. */
+#ifdef THAW_INTAKE
+kernel void intake_flags(global const float4* pos, global const float4* vel, global const uchar* phase,
+                         global uchar* flag, global const float4* intake, const uint count, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  uchar f = 0;
+  if (phase[i] == THAW_PHASE_AIR) {
+    const float4 p = pos[i];
+    for (uint k = 0; k < count && f == 0; ++k) {
+      const float4 a = intake[4 * k], b = intake[4 * k + 1], c = intake[4 * k + 2], e = intake[4 * k + 3];
+      const float3 d = p.xyz - a.xyz;
+      const float s = dot(d, b.xyz);
+      if (s < -b.w - e.y || s >= c.x) continue;
+      const float3 radial = d - s * b.xyz;
+      const float r2 = dot(radial, radial);
+      const uint dryer = (uint)c.z;
+      if (s >= -b.w && r2 < c.w) {
+        const float3 v = vel[i].xyz;
+        const float3 off = v - e.x * b.xyz;
+        if (s < 0.0f ? dot(off, off) > 1e-6f * e.x * e.x : dot(v, b.xyz) < c.y) f = (uchar)(2 * dryer + 1);
+      } else if (s < 0.0f && r2 < a.w) {
+        f = (uchar)(2 * dryer + 2);
+      }
+    }
+  }
+  flag[i] = f;
+}
+
+/* The pipes' air moves out at the exit speed (see above): run before the drift. */
+kernel void pipe_drive(global const float4* pos, global float4* vel, global const uchar* phase,
+                       global const float4* intake, const uint count, const uint n) {
+  const uint i = get_global_id(0);
+  if (i >= n || phase[i] != THAW_PHASE_AIR) return;
+  const float4 p = pos[i];
+  for (uint k = 0; k < count; ++k) {
+    const float4 a = intake[4 * k], b = intake[4 * k + 1], c = intake[4 * k + 2], e = intake[4 * k + 3];
+    const float3 d = p.xyz - a.xyz;
+    const float s = dot(d, b.xyz);
+    if (s < -b.w || s >= 0.0f) continue;
+    const float3 radial = d - s * b.xyz;
+    if (dot(radial, radial) >= c.w) continue;
+    const float4 v = vel[i];
+    vel[i] = (float4)(e.x * b.xyz, v.w);
+    return;
+  }
+}
+#define THAW_INTAKE_ARG , global const uchar *take
+#else
+#define THAW_INTAKE_ARG
+#endif
+
 kernel void cell_keys(global float4* pos, global float4* vel, global const uchar* phase, global uint* keys,
-                      global uint* order, volatile global uint* clamped, const Grid g, const KeysParams P) {
+                      global uint* order, volatile global uint* clamped, const Grid g,
+                      const KeysParams P THAW_INTAKE_ARG) {
   const uint i = get_global_id(0);
   const uint n = P.n, open_faces = P.open_faces, ncells = P.ncells;
   const float4 dmin = P.dmin, dmax = P.dmax;
   if (i >= n) return;
   float4 p = pos[i];
   order[i] = i;
+#ifdef THAW_INTAKE
+  if (P.intakes && take[i]) {
+    keys[i] = ncells;
+    return;
+  }
+#endif
   if (!THAW_IS_STATIC(phase[i])) {
 #if THAW_WY || THAW_WZ
     /* Along a periodic axis a particle that left through one side comes back through the other. */

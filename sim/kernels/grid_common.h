@@ -29,7 +29,7 @@ typedef struct {
   uint open_faces;    /* sides water leaves through: bit 2a lower, 2a + 1 upper side of axis a */
   uint ncells;        /* the key of a particle that left */
   uint n;             /* particles */
-  uint pad;
+  uint intakes;       /* -DTHAW_INTAKE: nonzero when some take[i] marks air an air dryer takes in (grid.cl) */
 } KeysParams;
 
 int4 grid_cell(const Grid g, float4 p) {

@@ -53,6 +53,7 @@ ValidationCase stefan_case();
 ValidationCase rigid_spin_case();
 ValidationCase floating_case();
 ValidationCase cavity_case();
+ValidationCase jet_case();
 
 }  // namespace thaw
 

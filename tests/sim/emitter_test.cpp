@@ -20,7 +20,6 @@ namespace thaw {
 namespace {
 
 using testing::ClSuite;
-using testing::read_file_bytes;
 using testing::TempDir;
 
 // A tank 6 x 6 cm, 12 cm tall, open at the top, with a tap 10 cm above its floor; no water at the start.
@@ -56,11 +55,6 @@ double mass_crossed(const HostParticles& p, double plane, std::vector<std::uint8
     if (seen[p.id[i]]) m += p.position[i][3];
   }
   return m;
-}
-
-std::string state_bytes(const Solver& s, const TempDir& dir, const std::string& name) {
-  write_state_file(dir / name, s.state());
-  return read_file_bytes(dir / name);
 }
 
 class EmitterTest : public ClSuite {};
@@ -191,13 +185,13 @@ TEST_F(EmitterTest, GrowingTheCapacityMidRunAndResumingAreBitwiseTheSame) {
   write_state_file(dir / "after.state", straight.state());
   const std::uint64_t after = straight.steps();
   for (int i = 0; i < 30; ++i) straight.step();
-  const std::string expected = state_bytes(straight, dir, "straight.state");
+  const std::string expected = testing::state_file_bytes(straight.state(), dir, "straight.state");
 
   for (const auto& [file, from] : {std::pair{"before.state", before}, std::pair{"after.state", after}}) {
     Solver resumed(cl(), scene, read_state_file(dir / file));
     while (resumed.steps() < straight.steps()) resumed.step();
     EXPECT_EQ(resumed.capacity(), straight.capacity()) << file;
-    const std::string got = state_bytes(resumed, dir, "resumed.state");
+    const std::string got = testing::state_file_bytes(resumed.state(), dir, "resumed.state");
     EXPECT_TRUE(got == expected) << "resumed from " << file << " (step " << from << ") differs";
   }
 }
