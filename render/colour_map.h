@@ -23,11 +23,15 @@ struct ColourBar {
 };
 ColourBar draw_colour_bar(Image& image);
 
-// The bar's numbers: `hi` at its top, the middle, `lo` at its bottom, as "12.3 °C", drawn left of the
-// strip in a 5x7 pixel font (scaled with the image: 2x at 480 rows) on a dark plate, so every picture
-// of a temperature view, a PNG from `thaw render` or a streamed frame, says what its colours mean.
-void label_colour_bar(Image& image, const ColourBar& bar, double lo, double hi);
-std::array<std::string, 3> colour_bar_labels(double lo, double hi);  // top, middle, bottom
+// The bar's numbers: `hi` at its top, the middle, `lo` at its bottom, as "12.3 °C" (or "0.25 m/s"),
+// drawn left of the strip in a 5x7 pixel font (scaled with the image: 2x at 480 rows) on a dark plate, so
+// every picture of a temperature or speed view, a PNG from `thaw render` or a streamed frame, says what
+// its colours mean.
+enum class BarUnit { Celsius, MetresPerSecond };
+void label_colour_bar(Image& image, const ColourBar& bar, double lo, double hi,
+                      BarUnit unit = BarUnit::Celsius);
+std::array<std::string, 3> colour_bar_labels(double lo, double hi,
+                                             BarUnit unit = BarUnit::Celsius);  // top, middle, bottom
 
 // Text in the 5x7 font: digits, '.', '-', '+', ' ', '°' and 'C' (anything else is a blank cell),
 // `scale` image pixels per font pixel, its top left at (x, y); clipped to the image.

@@ -52,17 +52,52 @@ void temperature_range(const RenderSnapshot& s, double& lo, double& hi) {
   }
 }
 
+// The speed scale: the given one, else 0 to the fastest water or air (all particles without any).
+void speed_range(const RenderSnapshot& s, double& lo, double& hi) {
+  if (lo < hi) return;
+  if (s.speed.size() != s.position.size()) throw Error("colouring by speed needs the particles' velocities");
+  lo = 0;
+  hi = 0;
+  bool flowing = false;
+  for (std::size_t i = 0; i < s.speed.size(); ++i) {
+    const auto ph = static_cast<Phase>(s.phase[i]);
+    if (ph != Phase::Water && ph != Phase::Air) continue;
+    flowing = true;
+    hi = std::max(hi, double(s.speed[i]));
+  }
+  if (!flowing)
+    for (float v : s.speed) hi = std::max(hi, double(v));
+  if (hi < 1e-3) hi = 1e-3;
+}
+
+// What a scalar view draws: temperature [°C] or speed [m/s], with its scale (the given one, or the
+// particles' range) and the colour bar's unit.
+struct Scalar {
+  const std::vector<float>* values;
+  BarUnit unit;
+};
+Scalar scalar_of(const RenderSnapshot& s, const std::string& colour_by, double& lo, double& hi) {
+  if (colour_by == "speed") {
+    speed_range(s, lo, hi);
+    return {&s.speed, BarUnit::MetresPerSecond};
+  }
+  temperature_range(s, lo, hi);
+  return {&s.temperature, BarUnit::Celsius};
+}
+
 }  // namespace
 
 ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, const ParticleViewOptions& o) {
-  if (o.colour_by != "phase" && o.colour_by != "temperature")
-    throw Error("particle view: unknown colouring '" + o.colour_by + "'; available: phase, temperature");
+  if (o.colour_by != "phase" && o.colour_by != "temperature" && o.colour_by != "speed")
+    throw Error("particle view: unknown colouring '" + o.colour_by +
+                "'; available: phase, temperature, speed");
   ViewImage out;
   out.image = background(cam.width, cam.height);
-  const bool by_t = o.colour_by == "temperature";
+  const bool by_t = o.colour_by != "phase";
   out.t_min = o.t_min;
   out.t_max = o.t_max;
-  if (by_t) temperature_range(s, out.t_min, out.t_max);
+  const Scalar field =
+      by_t ? scalar_of(s, o.colour_by, out.t_min, out.t_max) : Scalar{nullptr, BarUnit::Celsius};
 
   const Eigen::Matrix4f view = cam.view();
   const double focal = 0.5 * cam.height / std::tan(0.5 * cam.fov * M_PI / 180.0);
@@ -78,7 +113,7 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, cons
                  py = 0.5 * cam.height - focal * c.y() / z - 0.5;
     const double r = std::max(0.75, focal * radius / z);
     Rgb colour = by_t && !(static_cast<Phase>(s.phase[i]) == Phase::Solid)
-                     ? cool_warm((s.temperature[i] - out.t_min) / (out.t_max - out.t_min))
+                     ? cool_warm(((*field.values)[i] - out.t_min) / (out.t_max - out.t_min))
                      : phase_rgb(s.phase[i]);
     const int x0 = std::max(0, int(std::floor(px - r))), x1 = std::min(cam.width - 1, int(std::ceil(px + r)));
     const int y0 = std::max(0, int(std::floor(py - r))),
@@ -100,7 +135,7 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, cons
   }
   if (by_t) {
     out.bar = draw_colour_bar(out.image);
-    label_colour_bar(out.image, out.bar, out.t_min, out.t_max);
+    label_colour_bar(out.image, out.bar, out.t_min, out.t_max, field.unit);
   }
   return out;
 }
@@ -112,7 +147,8 @@ ViewImage render_slice(const RenderSnapshot& s, const SliceOptions& o) {
   out.image = background(o.width, o.height);
   out.t_min = o.t_min;
   out.t_max = o.t_max;
-  temperature_range(s, out.t_min, out.t_max);
+  const Scalar field = scalar_of(s, o.colour_by, out.t_min, out.t_max);
+  const std::vector<float>& values = *field.values;
   // In-plane axes: (u, v) = (y, z) for a plane of constant x, (x, z) for y, (x, y) for z; v points up.
   const int a = o.axis, ua = a == 0 ? 1 : 0, va = a == 2 ? 1 : 2;
   const Eigen::Vector3f lo = s.domain_min, hi = s.domain_max;
@@ -149,7 +185,7 @@ ViewImage render_slice(const RenderSnapshot& s, const SliceOptions& o) {
             d[a] -= plane;
             const double w = sph::cubic_spline_w(d.norm(), H);
             sw += w;
-            st += w * s.temperature[p];
+            st += w * values[p];
           }
         }
       if (sw <= 0) continue;
@@ -160,7 +196,7 @@ ViewImage render_slice(const RenderSnapshot& s, const SliceOptions& o) {
       px[2] = c[2];
     }
   out.bar = draw_colour_bar(out.image);
-  label_colour_bar(out.image, out.bar, out.t_min, out.t_max);
+  label_colour_bar(out.image, out.bar, out.t_min, out.t_max, field.unit);
   return out;
 }
 

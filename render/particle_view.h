@@ -1,7 +1,7 @@
 #pragma once
 // The particle view: every particle as a small shaded sphere (drawn on the CPU with a depth buffer),
-// coloured by phase or by temperature with a colour bar; and the slice view: temperature on a plane
-// through the scene, interpolated from the particles near it.
+// coloured by phase, temperature or speed with a colour bar; and the slice view: temperature or speed on
+// a plane through the scene, interpolated from the particles near it.
 #include <string>
 
 #include "render/camera.h"
@@ -12,14 +12,16 @@
 namespace thaw {
 
 struct ParticleViewOptions {
-  std::string colour_by = "phase";  // "phase" | "temperature"
-  double t_min = 0, t_max = 0;      // temperature scale [°C]; t_min == t_max: the particles' own range
+  std::string colour_by = "phase";  // "phase" | "temperature" | "speed"
+  // The scale [°C or m/s]; t_min == t_max: the particles' own range (for speed 0 to the fastest water or
+  // air particle).
+  double t_min = 0, t_max = 0;
   bool solids = true;               // draw static solids (walls, plates)
 };
 
 struct ViewImage {
   Image image;
-  double t_min = 0, t_max = 0;  // the temperature scale used (colour bar bottom and top)
+  double t_min = 0, t_max = 0;  // the scale used (colour bar bottom and top) [°C or m/s]
   ColourBar bar;                // where the colour bar is; empty for phase colours
 };
 
@@ -28,12 +30,13 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& camera, c
 struct SliceOptions {
   int axis = 1;            // the plane's normal: 0 x, 1 y, 2 z
   double position = 0.5;   // where along that axis, as a fraction of the domain
+  std::string colour_by = "temperature";  // "speed": |v|; anything else: temperature
   double t_min = 0, t_max = 0;
   int width = 640, height = 480;
 };
 
-// Temperature by Shepard interpolation (sum T_j W / sum W, W the cubic spline over 2 spacings) on the
-// plane, framed to the domain; pixels with no particle within reach show the background.
+// Temperature or speed by Shepard interpolation (sum T_j W / sum W, W the cubic spline over 2 spacings) on
+// the plane, framed to the domain; pixels with no particle within reach show the background.
 ViewImage render_slice(const RenderSnapshot& s, const SliceOptions& o);
 
 }  // namespace thaw

@@ -1,6 +1,7 @@
 #include "render/snapshot.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "sim/error.h"
@@ -32,10 +33,15 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
       s.glass[i] = p.material[i] < scene.materials.size() && scene.materials[p.material[i]].transparent;
   }
   s.temperature = temperature;
+  if (p.velocity.size() == p.size()) {
+    s.speed.reserve(p.size());
+    for (const Float4& v : p.velocity) s.speed.push_back(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+  }
   for (const Dryer& d : scene.dryers)
     s.dryers.push_back({d.position.cast<float>(), d.direction.normalized().cast<float>(),
                         static_cast<float>(0.5 * d.nozzle_diameter), static_cast<float>(d.half_angle),
-                        static_cast<float>(d.reach), d.on});
+                        // An air dryer's air is drawn by its particles: no cone.
+                        d.model == DryerModel::Air ? 0.0f : static_cast<float>(d.reach), d.on});
   for (const Emitter& e : scene.emitters)
     s.dryers.push_back({e.position.cast<float>(), e.direction.normalized().cast<float>(),
                         static_cast<float>(e.radius), 0.0f, 0.0f, false});

@@ -32,6 +32,7 @@ struct RenderSnapshot {
   std::vector<std::uint8_t> phase;        // thaw::Phase
   std::vector<std::uint8_t> glass;        // 1 for a solid particle of a transparent material; empty: none
   std::vector<float> temperature;         // [°C]; empty when the scene has no heat
+  std::vector<float> speed;               // |v| [m/s]
   // The scene's dryers as they are at this step, then its taps (emitters): a tap is drawn as a dryer's
   // nozzle that never blows (on = false), its radius the nozzle's.
   std::vector<DryerMarker> dryers;

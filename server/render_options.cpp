@@ -55,8 +55,8 @@ RenderOptions render_options(const CliArgs& args, const SceneCamera& camera) {
     o.quality = *v;
   }
   if (auto v = args.value("--colour-by")) {
-    if (*v != "phase" && *v != "temperature")
-      throw Error("--colour-by: unknown colouring '" + *v + "'; available: phase, temperature");
+    if (*v != "phase" && *v != "temperature" && *v != "speed")
+      throw Error("--colour-by: unknown colouring '" + *v + "'; available: phase, temperature, speed");
     o.colour_by = *v;
   }
   if (auto v = args.value("--slice")) {
@@ -149,6 +149,7 @@ Image render_cpu_view(const RenderOptions& o, const RenderSnapshot& s, const Orb
   slice.position = o.slice_position;
   slice.width = o.width;
   slice.height = o.height;
+  slice.colour_by = o.colour_by;
   return render_slice(s, slice).image;
 }
 

@@ -17,7 +17,7 @@ namespace thaw {
 
 struct RenderOptions {
   std::string view = "surface";     // surface | particles | slice
-  std::string colour_by = "phase";  // particles: phase | temperature
+  std::string colour_by = "phase";  // particles: phase | temperature | speed; slice: speed or temperature
   std::string quality = "full";     // surface: full | fast (SurfaceRenderer::Quality)
   double scale = 1.0;               // surface: the fraction of width and height marched (SurfaceRenderer)
   int slice_axis = 1;               // slice: the plane's normal axis
@@ -32,7 +32,7 @@ struct RenderOptions {
 };
 
 // The option names, for CliArgs: --size WxH, --camera AZ,EL[,DIST], --target X,Y,Z, --fov DEG, --view NAME,
-// --colour-by phase|temperature, --slice AXIS[,FRACTION], --field-cells N, --quality full|fast.
+// --colour-by phase|temperature|speed, --slice AXIS[,FRACTION], --field-cells N, --quality full|fast.
 inline const char* const kRenderValueOptions[] = {"--size",  "--camera",      "--target",
                                                   "--fov",   "--view",        "--colour-by",
                                                   "--slice", "--field-cells", "--quality"};

@@ -64,7 +64,7 @@ class RenderWorker {
   void reset_camera(const SceneCamera& camera);
   // Relative: degrees added to azimuth and elevation (clamped to +-89), distance multiplied by zoom.
   void orbit(double d_azimuth, double d_elevation, double zoom);
-  // view: surface | particles | slice; colour_by: phase | temperature.
+  // view: surface | particles | slice; colour_by: phase | temperature | speed.
   void set_view(const std::string& view, std::optional<std::string> colour_by = {});
   // width 16..1920, height 16..1080, jpeg_quality 10..95, fps cap 1..60, surface full | fast, scale
   // SurfaceRenderer::kMinScale..1.

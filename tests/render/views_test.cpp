@@ -1,4 +1,4 @@
-// The particle and slice views: colours by phase and temperature, and their colour bar.
+// The particle and slice views: colours by phase, temperature and speed, and their colour bar.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -81,10 +81,34 @@ TEST(ParticleView, PhaseColoursTellIceFromWater) {
   EXPECT_LT(ice.dot(water), 0.97);
 }
 
+// By speed (air or water; issue 18's views): a still particle takes the bar's bottom colour, the fastest
+// its top, the scale running from 0 to the fastest, labelled in m/s.
+TEST(ParticleView, SpeedColoursRunFromStillToTheFastest) {
+  RenderSnapshot s = two_particles(20.0f, 20.0f);
+  s.phase = {static_cast<std::uint8_t>(Phase::Air), static_cast<std::uint8_t>(Phase::Air)};
+  s.speed = {0.0f, 2.5f};
+  const OrbitCamera cam = front_camera();
+  ParticleViewOptions o;
+  o.colour_by = "speed";
+  const ViewImage v = render_particles(s, cam, o);
+  EXPECT_DOUBLE_EQ(v.t_min, 0.0);
+  EXPECT_DOUBLE_EQ(v.t_max, 2.5);
+  int x = 0, y = 0;
+  project(cam, s.position[0], x, y);
+  EXPECT_GT(chroma(v.image.pixel(x, y)).dot(chroma(cool_warm(0.0))), 0.999);
+  project(cam, s.position[1], x, y);
+  EXPECT_GT(chroma(v.image.pixel(x, y)).dot(chroma(cool_warm(1.0))), 0.999);
+  EXPECT_EQ(colour_bar_labels(0, 2.5, BarUnit::MetresPerSecond),
+            (std::array<std::string, 3>{"2.50 m/s", "1.25 m/s", "0.00 m/s"}));
+  // Without velocities there is nothing to colour by.
+  s.speed.clear();
+  EXPECT_THROW(render_particles(s, cam, o), Error);
+}
+
 TEST(ParticleView, UnknownColouringAndMissingTemperaturesAreErrors) {
   RenderSnapshot s = two_particles(0.0f, 1.0f);
   ParticleViewOptions o;
-  o.colour_by = "speed";
+  o.colour_by = "velocity";
   EXPECT_THROW(render_particles(s, front_camera(), o), Error);
   s.temperature.clear();
   o.colour_by = "temperature";
@@ -121,6 +145,17 @@ TEST(SliceView, LinearTemperatureRunsAcrossTheColourBar) {
   EXPECT_GT(chroma(v.image.pixel(column_of(-0.09), y)).dot(chroma(cool_warm(0.05))), 0.995);
   EXPECT_GT(chroma(v.image.pixel(column_of(0.0), y)).dot(chroma(cool_warm(0.5))), 0.995);
   EXPECT_GT(chroma(v.image.pixel(column_of(0.09), y)).dot(chroma(cool_warm(0.95))), 0.995);
+
+  // The same lattice moving at |v| = 10 |x| (a jet's two sides): by speed, the slice is at the bar's
+  // bottom in the middle and near its top at both ends, whatever the temperatures say.
+  for (const Eigen::Vector3f& x : s.position) s.speed.push_back(10.0f * std::abs(x.x()));
+  o.colour_by = "speed";
+  o.t_min = 0;
+  o.t_max = 1;
+  const ViewImage w = render_slice(s, o);
+  EXPECT_GT(chroma(w.image.pixel(column_of(0.0), y)).dot(chroma(cool_warm(0.0))), 0.995);
+  EXPECT_GT(chroma(w.image.pixel(column_of(-0.09), y)).dot(chroma(cool_warm(0.9))), 0.995);
+  EXPECT_GT(chroma(w.image.pixel(column_of(0.09), y)).dot(chroma(cool_warm(0.9))), 0.995);
 }
 
 // Light pixels (the labels' text) in a box of the image.

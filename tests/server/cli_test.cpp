@@ -364,7 +364,7 @@ TEST(ThawCli, FramesMeshesAndRenderedStates) {
       run_thaw("render s.state --out p.png --size 160x120 --pick 0,0 --target 0.06,0.06,0.5", dir);
   EXPECT_NE(corner.out.find("no surface"), std::string::npos) << corner.out;
   for (const char* bad : {"--view wireframe", "--size 10x10", "--camera 30", "--slice w,0.5",
-                          "--colour-by speed", "--target 1,2", "--fov 200", "--pick 700,1"}) {
+                          "--colour-by velocity", "--target 1,2", "--fov 200", "--pick 700,1"}) {
     const auto b = run_thaw(std::string("render s.state --out b.png ") + bad, dir);
     ASSERT_TRUE(b.exited) << bad;
     EXPECT_EQ(b.exit_code, 2) << bad;

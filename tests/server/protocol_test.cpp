@@ -568,7 +568,7 @@ TEST(ProtocolRefuse, ViewAndQuality) {
       {R"({"type":"view.set"})", "view.set", "view"},
       {R"({"type":"view.set","view":"wireframe"})", "view.set", "view"},
       {R"({"type":"view.set","view":1})", "view.set", "view"},
-      {R"({"type":"view.set","view":"surface","colour_by":"speed"})", "view.set", "colour_by"},
+      {R"({"type":"view.set","view":"surface","colour_by":"velocity"})", "view.set", "colour_by"},
       {R"({"type":"quality.set","width":15})", "quality.set", "width"},
       {R"({"type":"quality.set","width":1921})", "quality.set", "width"},
       {R"({"type":"quality.set","width":640.5})", "quality.set", "width"},
