@@ -36,6 +36,7 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
   if (plan.walls) opts += " -DTHAW_WALL_HEAT";
   if (plan.lamps) opts += " -DTHAW_LAMPS";
   if (plan.adiabatic) opts += " -DTHAW_ADIABATIC";
+  if (plan.air_faces) opts += " -DTHAW_AIR_FACES";
   for (int a = 0; a < 3; ++a)
     if (scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
@@ -184,6 +185,20 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
   P.n = n;
   P.rest_density = rest_density_;
   P.flow = scene_.solver.flow ? 1u : 0u;
+  if (plan_.air_faces) {
+    const AirFill& air = scene_.air;
+    P.face_material = static_cast<cl_uint>(air.material);
+    float* lo[3] = {&P.face_min_x, &P.face_min_y, &P.face_min_z};
+    float* hi[3] = {&P.face_max_x, &P.face_max_y, &P.face_max_z};
+    for (int a = 0; a < 3; ++a) {
+      const bool wraps = scene_.solver.periodic[static_cast<std::size_t>(a)];
+      *lo[a] = wraps ? -1e30f : static_cast<float>(scene_.domain.min[a]);
+      *hi[a] = wraps ? 1e30f : static_cast<float>(scene_.domain.max[a]);
+    }
+    P.face_depth = static_cast<float>(air.face_depth);
+    P.face_fraction = static_cast<float>(-std::expm1(-double(P.dt_heat) / air.face_time));
+    P.face_enthalpy = static_cast<float>(enthalpy_at(scene_, air.material, scene_.heat.ambient_temperature));
+  }
   set_args(k_thermal_state_, store_[core_.position], store_[core_.density], store_[enthalpy_],
            store_[core_.phase], store_[core_.material], materials_, thermal_, P);
   launch(q, k_thermal_state_, layout_.n);

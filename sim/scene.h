@@ -89,6 +89,11 @@ struct AirFill {
   Buoyancy buoyancy = Buoyancy::Boussinesq;
   double reference_temperature = 20.0;  // T0 [°C]
   double expansion = 1.0 / 293.15;      // beta [1/K]; an ideal gas's 1 / (T0 + 273.15) unless given
+  // Domaradzki & Martyn sec. 7 (Fig. 6): air within face_depth of a side of the domain that is not
+  // periodic relaxes toward heat.ambient_temperature with time constant face_time, so a dryer does not
+  // heat a closed room without end; booked as ambient exchange. face_time 0: off.
+  double face_time = 0.0;   // [s]
+  double face_depth = 0.0;  // [m]; the scene loader puts one kernel support for 0
 };
 
 struct FluidBlock {

@@ -426,6 +426,21 @@ const Field& scene_schema() {
                       .at_least(0)
                       .at_most(1)
                       .optional(),
+                  number("face_exchange_time",
+                         "Air within face_exchange_depth of a side of the domain that is not periodic "
+                         "relaxes toward heat.ambient_temperature with this time constant, as if the room "
+                         "went on beyond it (Domaradzki & Martyn sec. 7); booked as ambient exchange. 0: "
+                         "off")
+                      .in("s")
+                      .def(0.0)
+                      .at_least(0)
+                      .at_most(1e6),
+                  number("face_exchange_depth",
+                         "How far from the sides the exchange reaches; 0: one kernel support")
+                      .in("m")
+                      .def(0.0)
+                      .at_least(0)
+                      .at_most(100),
               },
               "Air as particles (Domaradzki & Martyn sec. 6): the domain, or a region of it, filled with an "
               "air material on the particle lattice, except where fluid, ice or solids are. Warm air rises; "

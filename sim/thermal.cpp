@@ -122,6 +122,7 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
   plan.walls = wall_heat && scene.heat.wall_coefficient > 0;
   // Air particles carry the air's heat themselves: the ambient model, which stands for the air, is off.
   plan.ambient = scene.heat.ambient_coefficient > 0 && !scene.has_air();
+  plan.air_faces = scene.has_air() && scene.air.face_time > 0;
   // The adiabatic pass only where a solid or the walls are of such a material (not merely declared).
   auto adiabatic = [&](int m) { return m >= 0 && scene.materials[static_cast<std::size_t>(m)].adiabatic; };
   plan.adiabatic =
@@ -154,13 +155,16 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
     why << "temperatures range from " << *lo << " to " << *hi << " °C";
   } else if (plan.ambient && differs(scene.heat.ambient_temperature)) {
     why << "the ambient air is at " << scene.heat.ambient_temperature << " °C";
+  } else if (plan.air_faces && differs(scene.heat.ambient_temperature)) {
+    why << "the air exchanges heat with the ambient at " << scene.heat.ambient_temperature
+        << " °C near the sides";
   } else if (plan.walls && differs(scene.heat.wall_temperature)) {
     why << "the tank walls' outside is at " << scene.heat.wall_temperature << " °C";
   } else {
     why << "no heat: every particle is at " << (T.empty() ? 0.0 : double(*lo))
         << " °C and nothing heats or cools it";
     plan.reason = why.str();
-    plan.ambient = plan.walls = false;
+    plan.ambient = plan.walls = plan.air_faces = false;
     return plan;
   }
   plan.build = true;

@@ -49,6 +49,7 @@ struct HeatPlan {
   bool walls = false;    // tank walls exchange heat with the outside (heat.wall_coefficient > 0)
   bool lamps = false;    // the scene has lamps (the photon grid is built once one is on)
   bool adiabatic = false;  // the scene has adiabatic solids (their mirrored temperatures: heat.cl)
+  bool air_faces = false;  // air relaxes toward the ambient near the sides (air.face_exchange_time > 0)
   std::string reason;    // why heat is built or not, in words, for `thaw run`'s list of stages
 };
 HeatPlan plan_heat(const Scene& scene, const HostParticles& particles);

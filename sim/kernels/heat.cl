@@ -268,8 +268,21 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
 #endif
 
   const float mass = pi.w * m.thermal_mass_scale;
-  const float e_ambient = q_ambient * dt_heat, e_dryers = q_dryers * dt_heat, e_walls = q_walls * dt_heat;
-  const float e_total = (q_conduction + q_ambient + q_dryers + q_walls) * dt_heat + e_lamps;
+  float e_faces = 0.0f;
+#ifdef THAW_AIR_FACES
+  /* Domaradzki & Martyn sec. 7 (Fig. 6): air near the sides exchanges its temperature with the ambient,
+   * as if the room went on past them: the exact step of dh/dt = (h_a - h) / tau. */
+  if (mi == P.face_material) {
+    const float d = fmin(fmin(fmin(pi.x - P.face_min_x, P.face_max_x - pi.x), fmin(pi.y - P.face_min_y, P.face_max_y - pi.y)),
+                         fmin(pi.z - P.face_min_z, P.face_max_z - pi.z));
+    if (d < P.face_depth) {
+      const float2 h = enthalpy[i];
+      e_faces = mass * ((P.face_enthalpy - h.x) - h.y) * P.face_fraction;
+    }
+  }
+#endif
+  const float e_ambient = q_ambient * dt_heat + e_faces, e_dryers = q_dryers * dt_heat, e_walls = q_walls * dt_heat;
+  const float e_total = (q_conduction + q_ambient + q_dryers + q_walls) * dt_heat + e_lamps + e_faces;
   float2 e = add_compensated(enthalpy[i], e_total / mass);
   float e_held = 0.0f;
 #ifdef THAW_ADIABATIC

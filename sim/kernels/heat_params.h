@@ -21,11 +21,16 @@ typedef struct {
   unsigned int n;            /* particles */
   float rest_density;        /* rho0: the volume of static particles, and of all with the flow off */
   unsigned int flow;         /* 1: moving water takes its volume from its summation density */
-  unsigned int pad0;
+  unsigned int face_material; /* THAW_AIR_FACES: the air material that relaxes near the sides */
+  /* THAW_AIR_FACES (air.face_exchange_time): the sides air relaxes at (a periodic axis: +-1e30), how far
+   * from them, the fraction 1 - exp(-dt_heat / tau) of the way to face_enthalpy it goes a step. */
+  float face_min_x, face_min_y, face_min_z, face_max_x, face_max_y, face_max_z;
+  float face_depth, face_fraction, face_enthalpy; /* [m], -, [J/kg] */
+  unsigned int pad1;
 } HeatParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(HeatParams) == 64, "HeatParams must match its OpenCL layout");
+static_assert(sizeof(HeatParams) == 104, "HeatParams must match its OpenCL layout");
 }  // namespace thaw::heat
 #endif
 

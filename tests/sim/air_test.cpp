@@ -460,6 +460,49 @@ TEST_F(AirTest, AnAirDryerRunResumesBitwise) {
   EXPECT_TRUE(testing::state_file_bytes(resumed.state(), dir, "resumed.state") == expected);
 }
 
+// Domaradzki & Martyn sec. 7: air within the exchange depth of a side relaxes toward the ambient as
+// exp(-t / tau), the air further in does not (still air that conducts nothing: each particle alone); the
+// heat it gives up is booked as ambient exchange and the energy closes. Periodic sides exchange nothing.
+TEST_F(AirTest, AirNearTheSidesRelaxesToTheAmbient) {
+  Json doc = air_box();
+  doc["materials"]["air"]["conductivity"] = 0.0;
+  doc["air"]["temperature"] = 40.0;
+  doc["air"]["face_exchange_time"] = 0.05;
+  doc["air"]["face_exchange_depth"] = 0.006;
+  doc["ambient"] = {{"temperature", 20.0}};
+  doc["domain"]["walls"] = Json::array();
+  doc["solids"] = Json::array();
+  doc["solver"] = {{"flow", false}, {"periodic", {"y"}}, {"max_dt", 0.002}};
+  const Scene scene = scene_from_json(doc);
+  ASSERT_DOUBLE_EQ(scene.air.face_time, 0.05);
+  Solver s(cl(), scene, initial_state(scene));
+  while (s.time() < 0.1 - 1e-9) s.step();
+  const double expected = 20.0 + 20.0 * std::exp(-s.time() / 0.05);
+  const HostParticles p = s.particles();
+  const std::vector<float> T = temperatures_of(p, scene);
+  int near = 0, inner = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double x = p.position[i][0], z = p.position[i][2];
+    const double d = std::min({x, 0.04 - x, z, 0.04 - z});  // y is periodic: no side there
+    if (d < 0.006) {
+      EXPECT_NEAR(T[i], expected, 1e-3) << "at x " << x << ", z " << z;
+      ++near;
+    } else {
+      EXPECT_NEAR(T[i], 40.0, 1e-4);
+      ++inner;
+    }
+  }
+  EXPECT_GT(near, 0);
+  EXPECT_GT(inner, 0);
+  const Metrics m = measure(s);
+  EXPECT_LT(s.energy_budget().ambient, 0.0);
+  EXPECT_LT(std::abs(m.closure()), 1e-6 * std::abs(s.energy_budget().ambient)) << "closure " << m.closure();
+  // Every particle near a side went the same way: the ambient term is their heat, m c dT each.
+  const double c = 1006.0, m_air = 1.2 * 0.005 * 0.005 * 0.005;
+  EXPECT_NEAR(s.energy_budget().ambient, near * m_air * c * (expected - 40.0),
+              1e-3 * std::abs(s.energy_budget().ambient));
+}
+
 // The jet case at res 4 (docs/VALIDATION-RESULTS.md has 4, 6 and 8): a diameter downstream the jet
 // carries the nozzle's mass, momentum and enthalpy flow within 3 %, and the books close.
 TEST_F(AirTest, TheJetCarriesWhatTheNozzleBlows) {
