@@ -695,16 +695,22 @@ Emitter emitter_from_json(const Json& j, const std::string& path, const std::vec
   return e;
 }
 
+namespace {
+// A nozzle's position inside the domain; SceneError at PATH.position otherwise.
+void check_nozzle_inside(const Eigen::Vector3d& x, const Scene& scene, const std::string& path) {
+  const Box& d = scene.domain;
+  if ((x.array() < d.min.array()).any() || (x.array() > d.max.array()).any())
+    throw SceneError(path + ".position", "[" + format_number(x.x()) + ", " + format_number(x.y()) + ", " +
+                                             format_number(x.z()) + "] lies outside the domain");
+}
+}  // namespace
+
 void check_emitter(const Emitter& e, const Scene& scene, const std::string& path) {
   if (e.radius < scene.spacing)
     throw SceneError(path + ".radius", format_number(e.radius) + " m is less than the particle spacing (" +
                                            format_number(scene.spacing) +
                                            " m): a nozzle must be at least one particle wide");
-  const Box& d = scene.domain;
-  if ((e.position.array() < d.min.array()).any() || (e.position.array() > d.max.array()).any())
-    throw SceneError(path + ".position", "[" + format_number(e.position.x()) + ", " +
-                                             format_number(e.position.y()) + ", " +
-                                             format_number(e.position.z()) + "] lies outside the domain");
+  check_nozzle_inside(e.position, scene, path);
 }
 
 void check_dryer(const Dryer& d, const Scene& scene, const std::string& path) {
@@ -726,11 +732,7 @@ void check_dryer(const Dryer& d, const Scene& scene, const std::string& path) {
                                                     format_number(2.0 * scene.spacing) +
                                                     " m): an air dryer's nozzle must be at least "
                                                     "two particles wide");
-  const Box& b = scene.domain;
-  if ((d.position.array() < b.min.array()).any() || (d.position.array() > b.max.array()).any())
-    throw SceneError(path + ".position", "[" + format_number(d.position.x()) + ", " +
-                                             format_number(d.position.y()) + ", " +
-                                             format_number(d.position.z()) + "] lies outside the domain");
+  check_nozzle_inside(d.position, scene, path);
 }
 
 Eigen::Vector3d unit_direction(const Eigen::Vector3d& v, const std::string& path) {

@@ -76,6 +76,21 @@ Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaul
   return f;
 }
 
+std::vector<Field> air_property_fields() {
+  return {number("density", "rho of the air").in("kg/m^3").def(1.2).above(0),
+          number("viscosity", "mu of the air").in("Pa s").def(1.8e-5).above(0),
+          number("conductivity", "k of the air").in("W/m/K").def(0.025).above(0),
+          number("specific_heat", "c of the air").in("J/kg/K").def(1006.0).above(0)};
+}
+
+Json air_material(const Json& params) {
+  return {{"kind", "air"},
+          {"density", params["density"]},
+          {"viscosity", params["viscosity"]},
+          {"conductivity", params["conductivity"]},
+          {"specific_heat", params["specific_heat"]}};
+}
+
 Line least_squares_line(const std::vector<double>& x, const std::vector<double>& y,
                         const std::vector<double>& w) {
   double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;

@@ -58,6 +58,11 @@ ValidationCase jet_case();
 }  // namespace thaw
 
 namespace thaw {
+// The properties of a case's air (rho 1.2, mu 1.8e-5, k 0.025, c 1006 by default): density, viscosity,
+// conductivity, specific_heat; and the air material they make.
+std::vector<Field> air_property_fields();
+Json air_material(const Json& params);
+
 // solver_schema() with some defaults changed, for a case that needs other solver defaults.
 Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaults);
 

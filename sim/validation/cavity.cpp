@@ -31,8 +31,9 @@ constexpr double kUmax[] = {3.649, 16.178, 34.73, 64.63};
 constexpr double kWmax[] = {3.697, 19.617, 68.59, 219.36};
 
 Field params() {
-  return object(
-      "",
+  std::vector<Field> fields = air_property_fields();
+  fields.insert(
+      fields.begin(),
       {
           number("rayleigh", "Ra = g beta dT L^3 / (nu alpha); the cavity's side L follows from it")
               .def(1e4)
@@ -50,10 +51,6 @@ Field params() {
               .at_most(500),
           choice("buoyancy", {"boussinesq", "none"}, "none: no flow, pure conduction (reference Nu = 1)")
               .def("boussinesq"),
-          number("density", "rho of the air").in("kg/m^3").def(1.2).above(0),
-          number("viscosity", "mu of the air").in("Pa s").def(1.8e-5).above(0),
-          number("conductivity", "k of the air").in("W/m/K").def(0.025).above(0),
-          number("specific_heat", "c of the air").in("J/kg/K").def(1006.0).above(0),
           number("gravity", "g").in("m/s^2").def(9.81).above(0),
           integer("depth", "Particles across the periodic depth (at least 3 kernel supports)")
               .def(9)
@@ -88,6 +85,7 @@ Field params() {
                               {"no_slip", "adami2012"},
                               {"max_dt", 0.05}}),
       });
+  return object("", std::move(fields));
 }
 
 // A column of the benchmark's table at Ra (Pr 0.71): a power law between neighbouring tabulated points.
@@ -172,8 +170,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
       {"solver", settings},
       {"ambient", {{"temperature", Tm}}},
       {"materials",
-       {{"air",
-         {{"kind", "air"}, {"density", rho}, {"viscosity", mu}, {"conductivity", k}, {"specific_heat", c}}},
+       {{"air", air_material(prm)},
         // Floor and ceiling: adiabatic, the air beside them conducting along them as in bulk (heat.cl).
         {"insulator",
          {{"kind", "solid"},

@@ -23,17 +23,14 @@ namespace thaw {
 namespace {
 
 Field params() {
-  return object(
-      "",
+  std::vector<Field> fields = air_property_fields();
+  fields.insert(
+      fields.begin(),
       {
           number("nozzle_diameter", "D").in("m").def(0.02).above(0).at_most(1),
           number("speed", "v at the nozzle").in("m/s").def(2.0).above(0).at_most(50),
           number("temperature", "T_j at the nozzle").in("°C").def(60.0).above(-100).at_most(500),
           number("ambient_temperature", "T_inf of the room").in("°C").def(20.0).above(-100).at_most(500),
-          number("density", "rho of the air").in("kg/m^3").def(1.2).above(0),
-          number("viscosity", "mu of the air").in("Pa s").def(1.8e-5).above(0),
-          number("conductivity", "k of the air").in("W/m/K").def(0.025).above(0),
-          number("specific_heat", "c of the air").in("J/kg/K").def(1006.0).above(0),
           // One diameter: further on the jet mixes with the room faster than a real one does (at res 6,
           // 2 D downstream: mass and enthalpy flow 15 % short, docs/VALIDATION-RESULTS.md).
           number("plane", "Where the fluxes are measured, in D downstream of the nozzle")
@@ -64,12 +61,13 @@ Field params() {
                               {"density_tolerance", 0.005},
                               {"max_dt", 0.01}}),
       });
+  return object("", std::move(fields));
 }
 
 CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double D = prm["nozzle_diameter"], v = prm["speed"], Tj = prm["temperature"];
   const double Tinf = prm["ambient_temperature"];
-  const double rho = prm["density"], mu = prm["viscosity"], k = prm["conductivity"], c = prm["specific_heat"];
+  const double rho = prm["density"], c = prm["specific_heat"];
   const double start = prm["start"], stop = prm["stop"];
   if (stop <= start)
     throw SceneError("stop", "the window must end after it starts (start " + format_number(start) + ")");
@@ -91,8 +89,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
       {"spacing", dx},
       {"solver", prm["solver"]},
       {"materials",
-       {{"air",
-         {{"kind", "air"}, {"density", rho}, {"viscosity", mu}, {"conductivity", k}, {"specific_heat", c}}},
+       {{"air", air_material(prm)},
         {"insulator",
          {{"kind", "solid"},
           {"density", rho},
