@@ -91,6 +91,14 @@ Json air_material(const Json& params) {
           {"specific_heat", params["specific_heat"]}};
 }
 
+Json air_insulator(const Json& params) {
+  return {{"kind", "solid"},
+          {"density", params["density"]},
+          {"conductivity", 0.0},
+          {"specific_heat", params["specific_heat"]},
+          {"adiabatic", true}};
+}
+
 Line least_squares_line(const std::vector<double>& x, const std::vector<double>& y,
                         const std::vector<double>& w) {
   double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;

@@ -62,6 +62,8 @@ namespace thaw {
 // conductivity, specific_heat; and the air material they make.
 std::vector<Field> air_property_fields();
 Json air_material(const Json& params);
+// An adiabatic solid with the air's density and specific heat (walls that pass no heat, sim/kernels/heat.cl).
+Json air_insulator(const Json& params);
 
 // solver_schema() with some defaults changed, for a case that needs other solver defaults.
 Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaults);

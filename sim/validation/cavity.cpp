@@ -172,12 +172,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
       {"materials",
        {{"air", air_material(prm)},
         // Floor and ceiling: adiabatic, the air beside them conducting along them as in bulk (heat.cl).
-        {"insulator",
-         {{"kind", "solid"},
-          {"density", rho},
-          {"conductivity", 0.0},
-          {"specific_heat", c},
-          {"adiabatic", true}}},
+        {"insulator", air_insulator(prm)},
         // The held walls conduct like the air, so the air's temperature is T_w at the wall's plane.
         {"wall", {{"kind", "solid"}, {"density", rho}, {"conductivity", k}, {"specific_heat", c}}}}},
       {"air",

@@ -67,7 +67,7 @@ Field params() {
 CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double D = prm["nozzle_diameter"], v = prm["speed"], Tj = prm["temperature"];
   const double Tinf = prm["ambient_temperature"];
-  const double rho = prm["density"], c = prm["specific_heat"];
+  const double rho = prm["density"];
   const double start = prm["start"], stop = prm["stop"];
   if (stop <= start)
     throw SceneError("stop", "the window must end after it starts (start " + format_number(start) + ")");
@@ -88,14 +88,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
       {"gravity", {0.0, 0.0, 0.0}},
       {"spacing", dx},
       {"solver", prm["solver"]},
-      {"materials",
-       {{"air", air_material(prm)},
-        {"insulator",
-         {{"kind", "solid"},
-          {"density", rho},
-          {"conductivity", 0.0},
-          {"specific_heat", c},
-          {"adiabatic", true}}}}},
+      {"materials", {{"air", air_material(prm)}, {"insulator", air_insulator(prm)}}},
       {"air", {{"material", "air"}, {"temperature", Tinf}, {"buoyancy", "none"}}},
       {"dryers",
        {{{"model", "air"},
