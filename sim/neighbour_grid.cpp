@@ -145,8 +145,8 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
       set_args(k_intake_flags_, store[f.position], store[f.velocity], store[f.phase], take_, intakes_,
                static_cast<cl_uint>(in.size() / 4), n);
       launch(q, k_intake_flags_, layout_.n);
-      // Which to take in, in index order (the sort's, so a rerun chooses the same): every slow particle
-      // in a pipe (the discs run into it), one in a body while its dryer owes.
+      // Which to take in, in index order (the sort's, so a rerun chooses the same): every one flagged in
+      // a pipe or a mouth (it is in the discs' way), one in a housing while its dryer owes.
       take_host_.resize(layout_.n);
       q.enqueueReadBuffer(take_, CL_TRUE, 0, layout_.n, take_host_.data());
       bool changed = false;

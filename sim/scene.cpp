@@ -490,6 +490,10 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     s.dryers.push_back(dryer_from_json(doc["dryers"][i], join_path("dryers", i)));
     check_dryer(s.dryers.back(), s, join_path("dryers", i));
   }
+  // The intake's flags number a dryer in a byte (sim/kernels/grid.cl): 2k + 2 <= 255.
+  if (std::count_if(s.dryers.begin(), s.dryers.end(),
+                    [](const Dryer& d) { return d.model == DryerModel::Air; }) > kMaxAirDryers)
+    throw SceneError("dryers", "more than " + std::to_string(kMaxAirDryers) + " air dryers");
   for (std::size_t i = 0; i < doc["emitters"].size(); ++i) {
     Json e = doc["emitters"][i];
     if (!e.contains("temperature")) e["temperature"] = s.heat.ambient_temperature;

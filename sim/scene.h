@@ -264,6 +264,7 @@ void check_emitter(const Emitter& e, const Scene& scene, const std::string& path
 // air dryer, the scene's air to blow, a nozzle at least two spacings wide and inside the domain (SceneError
 // at PATH.model, PATH.nozzle_diameter or PATH.position).
 void check_dryer(const Dryer& d, const Scene& scene, const std::string& path);
+inline constexpr int kMaxAirDryers = 64;  // a scene's air dryers at most (their intake flags are bytes)
 
 // `v` scaled to unit length; `path` names it in the SceneError when it is not a vector of moderate size:
 // zero, or so long or so short that its squared length overflows or underflows a double. The protocol

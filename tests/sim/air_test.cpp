@@ -145,6 +145,10 @@ TEST(AirScene, ErrorsNameTheirPath) {
   EXPECT_EQ(error_path(doc), "dryers[0].position");
   doc["dryers"][0]["position"] = {0.02, 0.02, 0.03};
   EXPECT_NO_THROW(scene_from_json(doc));
+  // Their intake numbers them in a byte.
+  while (doc["dryers"].size() <= std::size_t(kMaxAirDryers)) doc["dryers"].push_back(doc["dryers"][0]);
+  EXPECT_EQ(error_path(doc), "dryers");
+  doc["dryers"] = {doc["dryers"][0]};
   doc.erase("air");
   doc["fluids"] = {{{"material", "water"}, {"box", box(0, 0, 0, 0.04, 0.04, 0.01)}}};
   EXPECT_EQ(error_path(doc), "dryers[0].model");
