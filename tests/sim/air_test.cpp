@@ -507,10 +507,11 @@ TEST_F(AirTest, AirNearTheSidesRelaxesToTheAmbient) {
               1e-3 * std::abs(s.energy_budget().ambient));
 }
 
-// The jet case at res 4 (docs/VALIDATION-RESULTS.md has 4, 6 and 8): a diameter downstream the jet
-// carries the nozzle's mass, momentum and enthalpy flow within 3 %, and the books close.
+// The jet case at res 6 (docs/VALIDATION-RESULTS.md has 4, 6 and 8; at res 4 the momentum flow is 4 %
+// short): a diameter downstream the jet carries the nozzle's mass, momentum and enthalpy flow within 3 %,
+// and the books close.
 TEST_F(AirTest, TheJetCarriesWhatTheNozzleBlows) {
-  const CaseResult r = run_validation(cl(), "jet", 4, {});
+  const CaseResult r = run_validation(cl(), "jet", 6, {});
   for (const auto& [key, m] : r.metrics)
     std::printf("[ info ] %s %.5g (reference %.5g, error %.4g, gate %.3g)\n", key.c_str(), m.value,
                 m.reference, m.error, m.gate);
