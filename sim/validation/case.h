@@ -54,6 +54,10 @@ ValidationCase rigid_spin_case();
 ValidationCase floating_case();
 ValidationCase cavity_case();
 ValidationCase jet_case();
+ValidationCase air_sphere_case();
+
+// Churchill's correlation for natural convection around a sphere: Nu(Ra, Pr) (sim/validation/air_sphere.cpp).
+double churchill_sphere_nusselt(double rayleigh, double prandtl);
 
 }  // namespace thaw
 

@@ -518,5 +518,28 @@ TEST_F(AirTest, TheJetCarriesWhatTheNozzleBlows) {
   EXPECT_TRUE(r.passed());
 }
 
+// Churchill's correlation as the air-sphere case computes it: pure conduction (Nu 2) without buoyancy,
+// Nu - 2 growing as Ra^(1/4), and the value for a 3 cm sphere 20 K colder than air (Ra 5.8e4, Pr 0.72:
+// 2 + 0.589 * 15.53 / 1.296 = 9.06 by hand).
+TEST(AirSphere, ChurchillsCorrelationHasItsLimits) {
+  EXPECT_DOUBLE_EQ(churchill_sphere_nusselt(0.0, 0.72), 2.0);
+  EXPECT_NEAR((churchill_sphere_nusselt(16e4, 0.72) - 2.0) / (churchill_sphere_nusselt(1e4, 0.72) - 2.0), 2.0,
+              1e-12);
+  const double nu = 1.8e-5 / 1.2, alpha = 0.025 / (1.2 * 1006.0);
+  const double ra = 9.81 / 293.15 * 20.0 * 0.03 * 0.03 * 0.03 / (nu * alpha);
+  EXPECT_NEAR(ra, 5.82e4, 0.01e4);
+  EXPECT_NEAR(churchill_sphere_nusselt(ra, nu / alpha), 9.06, 0.02);
+}
+
+// A 3 cm sphere held at 0 °C in 20 °C air at res 6 (docs/VALIDATION-RESULTS.md has 6, 8 and 12): the heat
+// the air brings it by natural convection within the case's 20 % of Churchill's correlation.
+TEST_F(AirTest, AColdSphereTakesTheHeatChurchillsCorrelationGives) {
+  const CaseResult r = run_validation(cl(), "air-sphere", 6, {});
+  for (const auto& [key, m] : r.metrics)
+    std::printf("[ info ] %s %.5g (reference %.5g, error %.4g, gate %.3g)\n", key.c_str(), m.value,
+                m.reference, m.error, m.gate);
+  EXPECT_TRUE(r.passed());
+}
+
 }  // namespace
 }  // namespace thaw
