@@ -33,8 +33,8 @@ void label_colour_bar(Image& image, const ColourBar& bar, double lo, double hi,
 std::array<std::string, 3> colour_bar_labels(double lo, double hi,
                                              BarUnit unit = BarUnit::Celsius);  // top, middle, bottom
 
-// Text in the 5x7 font: digits, '.', '-', '+', ' ', '°' and 'C' (anything else is a blank cell),
-// `scale` image pixels per font pixel, its top left at (x, y); clipped to the image.
+// Text in the 5x7 font: digits, '.', '-', '+', ' ', '°', 'C', 'm', '/' and 's' (anything else is a blank
+// cell), `scale` image pixels per font pixel, its top left at (x, y); clipped to the image.
 void draw_text(Image& image, const std::string& text, int x, int y, int scale, const Rgb& colour);
 int text_width(const std::string& text, int scale);  // pixels, one blank column between characters
 

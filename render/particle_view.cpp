@@ -87,10 +87,21 @@ Scalar scalar_of(const RenderSnapshot& s, const std::string& colour_by, double& 
 
 }  // namespace
 
+const std::vector<std::string>& colourings() {
+  static const std::vector<std::string> names = {"phase", "temperature", "speed"};
+  return names;
+}
+
+void check_colouring(const std::string& value, const std::string& what) {
+  const auto& names = colourings();
+  if (std::find(names.begin(), names.end(), value) != names.end()) return;
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw Error(what + ": unknown colouring '" + value + "'; available: " + list);
+}
+
 ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, const ParticleViewOptions& o) {
-  if (o.colour_by != "phase" && o.colour_by != "temperature" && o.colour_by != "speed")
-    throw Error("particle view: unknown colouring '" + o.colour_by +
-                "'; available: phase, temperature, speed");
+  check_colouring(o.colour_by, "particle view");
   ViewImage out;
   out.image = background(cam.width, cam.height);
   const bool by_t = o.colour_by != "phase";

@@ -3,6 +3,7 @@
 // coloured by phase, temperature or speed with a colour bar; and the slice view: temperature or speed on
 // a plane through the scene, interpolated from the particles near it.
 #include <string>
+#include <vector>
 
 #include "render/camera.h"
 #include "render/colour_map.h"
@@ -10,6 +11,12 @@
 #include "render/snapshot.h"
 
 namespace thaw {
+
+// The colourings the particle view knows ("phase", "temperature", "speed"; the slice view takes the last
+// two), for every place that accepts one (CLI, protocol, render worker).
+const std::vector<std::string>& colourings();
+// Error "<what>: unknown colouring '<value>'; available: phase, temperature, speed" unless value is one.
+void check_colouring(const std::string& value, const std::string& what);
 
 struct ParticleViewOptions {
   std::string colour_by = "phase";  // "phase" | "temperature" | "speed"

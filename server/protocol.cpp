@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "render/particle_view.h"
 #include "sim/error.h"
 #include "sim/json_text.h"
 #include "sim/scene.h"
@@ -369,11 +370,10 @@ std::vector<Spec> build_specs() {
        number("d_elevation", "Change of elevation").in("deg").def(0.0),
        number("zoom", "Distance factor; < 1 moves closer").def(1.0).above(0.01).at_most(100)},
       read_camera_orbit));
-  rows.push_back(
-      row<ViewSet>("view.set",
-                   {choice("view", {"surface", "particles", "slice"}, "What is drawn"),
-                    choice("colour_by", {"phase", "temperature", "speed"}, "Colouring").optional()},
-                   read_view_set));
+  rows.push_back(row<ViewSet>("view.set",
+                              {choice("view", {"surface", "particles", "slice"}, "What is drawn"),
+                               choice("colour_by", colourings(), "Colouring").optional()},
+                              read_view_set));
   rows.push_back(
       row<QualitySet>("quality.set",
                       {integer("width", "Image width").in("px").at_least(16).at_most(1920).optional(),

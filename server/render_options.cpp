@@ -55,8 +55,7 @@ RenderOptions render_options(const CliArgs& args, const SceneCamera& camera) {
     o.quality = *v;
   }
   if (auto v = args.value("--colour-by")) {
-    if (*v != "phase" && *v != "temperature" && *v != "speed")
-      throw Error("--colour-by: unknown colouring '" + *v + "'; available: phase, temperature, speed");
+    check_colouring(*v, "--colour-by");
     o.colour_by = *v;
   }
   if (auto v = args.value("--slice")) {

@@ -292,8 +292,7 @@ void RenderWorker::orbit(double d_azimuth, double d_elevation, double zoom) {
 void RenderWorker::set_view(const std::string& view, std::optional<std::string> colour_by) {
   if (view != "surface" && view != "particles" && view != "slice")
     throw Error("view: unknown view '" + view + "'; available: surface, particles, slice");
-  if (colour_by && *colour_by != "phase" && *colour_by != "temperature" && *colour_by != "speed")
-    throw Error("colour_by: unknown colouring '" + *colour_by + "'; available: phase, temperature, speed");
+  if (colour_by) check_colouring(*colour_by, "colour_by");
   {
     std::lock_guard lock(mutex_);
     options_.view = view;

@@ -41,8 +41,7 @@ double EmitterStage::particles_per_second(const Dryer& d, double spacing) {
 }
 
 bool EmitterStage::needed(const Scene& scene) {
-  return !scene.emitters.empty() || std::any_of(scene.dryers.begin(), scene.dryers.end(),
-                                                [](const Dryer& d) { return d.model == DryerModel::Air; });
+  return !scene.emitters.empty() || scene.air_dryer_count() > 0;
 }
 
 std::size_t EmitterStage::lay(const Nozzle& z, double open_for, double& pending, HostParticles& out,
@@ -96,7 +95,7 @@ HostParticles EmitterStage::emit(double t, double dt, std::uint32_t& next_id) {
   }
   for (std::size_t k = 0; k < scene_.dryers.size(); ++k) {
     const Dryer& d = scene_.dryers[k];
-    if (d.model != DryerModel::Air || !d.on || !(d.speed > 0) || !(dt > 0)) continue;
+    if (!d.blows_air() || !(dt > 0)) continue;
     // Laid at the back of the dryer's pipe, which carries them to the exit at its speed (grid.cl).
     owed_[k] += double(lay({d.position - pipe_length(scene_) * d.direction, d.direction,
                             0.5 * d.nozzle_diameter, d.speed, d.temperature, scene_.air.material, Phase::Air},

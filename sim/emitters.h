@@ -53,6 +53,10 @@ class EmitterStage {
   // the exit has air behind it), and in spacings the depth of the mouth in front of the exit (where slow
   // room air is taken in) and of the body behind the pipe.
   static double pipe_length(const Scene& scene) { return scene.solver.support_ratio * scene.spacing; }
+  // The pipe's radius: the nozzle's and half a spacing, so the discs' outer particles are inside it.
+  static double pipe_radius(const Dryer& d, double spacing) {
+    return 0.5 * d.nozzle_diameter + 0.5 * spacing;
+  }
   static constexpr double mouth_depth = 1.5, body_depth = 3.0;
 
   // Emitters first, then the air dryers, in the scene's order.

@@ -61,9 +61,7 @@ std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const S
       // 10 % below de Vahl Davis's with it, within 2 % without. An air dryer's jet is another matter: at
       // 2 m/s against the far wall of a closed box (0.5 % density tolerance) 12 particles a step got
       // past the walls' pressure to the domain's face (clamped, 9,238 in 768 steps); with the push, none.
-      const bool blown = std::any_of(scene.dryers.begin(), scene.dryers.end(),
-                                     [](const Dryer& d) { return d.model == DryerModel::Air; });
-      f.push = blown ? 1.0f : 0.0f;
+      f.push = scene.air_dryer_count() > 0 ? 1.0f : 0.0f;
       if (air.buoyancy == Buoyancy::Boussinesq) {
         f.expansion = static_cast<float>(air.expansion);
         f.reference_temperature = static_cast<float>(air.reference_temperature);

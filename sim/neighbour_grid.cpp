@@ -59,8 +59,7 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
     info_.origin[a] = static_cast<float>(scene.domain.min[a]);
   }
   ncells_ = static_cast<std::uint32_t>(double(info_.nx) * info_.ny * info_.nz);
-  intake_ = std::any_of(scene.dryers.begin(), scene.dryers.end(),
-                        [](const Dryer& d) { return d.model == DryerModel::Air; });
+  intake_ = scene.air_dryer_count() > 0;
   // With open sides or intakes the keys run to ncells: particles that left sort behind every cell.
   const std::uint32_t max_key = scene.open_faces || intake_ ? ncells_ : ncells_ - 1;
   int bits = 1;
@@ -129,8 +128,8 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
     const double dx = scene_.spacing;
     for (std::size_t k = 0; k < scene_.dryers.size(); ++k) {
       const Dryer& dr = scene_.dryers[k];
-      if (dr.model != DryerModel::Air || !dr.on || !(dr.speed > 0)) continue;
-      const double r = 0.5 * dr.nozzle_diameter + dx, pipe = 0.5 * dr.nozzle_diameter + 0.5 * dx;
+      if (!dr.blows_air()) continue;
+      const double r = 0.5 * dr.nozzle_diameter + dx, pipe = EmitterStage::pipe_radius(dr, dx);
       const Eigen::Vector3d x = dr.position;
       const Eigen::Vector3d& u = dr.direction;
       in.push_back({{float(x.x()), float(x.y()), float(x.z()), float(r * r)}});

@@ -85,4 +85,11 @@ std::size_t HostParticles::count(Phase p) const {
   return static_cast<std::size_t>(std::count(phase.begin(), phase.end(), static_cast<std::uint8_t>(p)));
 }
 
+double HostParticles::mass(Phase p) const {
+  double m = 0;
+  for (std::size_t i = 0; i < size(); ++i)
+    if (phase[i] == static_cast<std::uint8_t>(p)) m += double(position[i][3]);
+  return m;
+}
+
 }  // namespace thaw

@@ -39,6 +39,7 @@ struct HostParticles {
   std::size_t size() const { return position.size(); }
   void resize(std::size_t n);  // every member and column
   std::size_t count(Phase p) const;
+  double mass(Phase p) const;  // of the particles of phase p [kg], summed in index order
   const HostColumn* column(const std::string& name) const;
   HostColumn* column(const std::string& name);
 };

@@ -491,8 +491,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     check_dryer(s.dryers.back(), s, join_path("dryers", i));
   }
   // The intake's flags number a dryer in a byte (sim/kernels/grid.cl): 2k + 2 <= 255.
-  if (std::count_if(s.dryers.begin(), s.dryers.end(),
-                    [](const Dryer& d) { return d.model == DryerModel::Air; }) > kMaxAirDryers)
+  if (s.air_dryer_count() > std::size_t(kMaxAirDryers))
     throw SceneError("dryers", "more than " + std::to_string(kMaxAirDryers) + " air dryers");
   for (std::size_t i = 0; i < doc["emitters"].size(); ++i) {
     Json e = doc["emitters"][i];
@@ -640,6 +639,11 @@ Lamp lamp_from_json(const Json& j, const std::string& path) {
 }
 
 double Emitter::area() const { return M_PI * radius * radius; }
+std::size_t Scene::air_dryer_count() const {
+  return static_cast<std::size_t>(
+      std::count_if(dryers.begin(), dryers.end(), [](const Dryer& d) { return d.model == DryerModel::Air; }));
+}
+
 double Dryer::area() const { return 0.25 * M_PI * nozzle_diameter * nozzle_diameter; }
 
 Json to_json(const Emitter& e, const std::vector<Material>& materials) {

@@ -145,6 +145,8 @@ struct Dryer {
   double nozzle_diameter = 0.04;                          // [m]
   // model air: the nozzle's area pi d^2 / 4 [m^2]
   double area() const;
+  // An air dryer that is blowing now (on, at a positive speed).
+  bool blows_air() const { return model == DryerModel::Air && on && speed > 0; }
 };
 
 // A nozzle that pours fluid (Iwasaki et al. 2010, Fig. 7): layers of particles on the disc of the nozzle,
@@ -231,6 +233,8 @@ struct Scene {
   std::vector<FluidBlock> fluids;
   AirFill air;
   bool has_air() const { return air.material >= 0; }
+  // How many dryers blow air particles (dryers[].model "air").
+  std::size_t air_dryer_count() const;
   std::vector<IceBlock> ice;
   std::vector<Solid> solids;
   HeatSettings heat;

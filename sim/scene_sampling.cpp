@@ -176,7 +176,7 @@ HostParticles sample_scene(const Scene& scene) {
     // taken in at the first step.
     for (const Dryer& d : scene.dryers) {
       if (d.model != DryerModel::Air) continue;
-      const double pipe = EmitterStage::pipe_length(scene), r = 0.5 * d.nozzle_diameter + 0.5 * dx;
+      const double pipe = EmitterStage::pipe_length(scene), r = EmitterStage::pipe_radius(d, dx);
       std::vector<std::uint8_t> in_pipe(points.size());
       for (std::size_t i = 0; i < points.size(); ++i) {
         const Vec3 x = points[i] - d.position;

@@ -143,11 +143,9 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
     return !T.empty() && (std::abs(double(*lo) - outside) > kSame || std::abs(double(*hi) - outside) > kSame);
   };
   std::ostringstream why;
-  const bool air_dryers = std::any_of(scene.dryers.begin(), scene.dryers.end(),
-                                      [](const Dryer& d) { return d.model == DryerModel::Air; });
   if (plan.dryers) {
     why << "the scene has dryers";
-  } else if (air_dryers) {
+  } else if (scene.air_dryer_count() > 0) {
     why << "the scene has an air dryer (its temperature can be set live)";
   } else if (plan.lamps) {
     why << "the scene has lamps";

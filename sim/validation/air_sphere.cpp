@@ -20,53 +20,46 @@ namespace thaw {
 namespace {
 
 Field params() {
-  std::vector<Field> fields = air_property_fields();
-  fields.insert(
-      fields.begin(),
-      {
-          number("diameter", "D of the sphere").in("m").def(0.03).above(0).at_most(1),
-          number("sphere_temperature", "T_s, where the sphere is held")
-              .in("°C")
-              .def(0.0)
-              .above(-100)
-              .at_most(500),
-          number("air_temperature", "T_inf, the air's starting and reference temperature")
-              .in("°C")
-              .def(20.0)
-              .above(-100)
-              .at_most(500),
-          number("gravity", "g").in("m/s^2").def(9.81).above(0),
-          number("width", "The box's width and depth, in diameters").def(4.0).at_least(2).at_most(20),
-          number("below", "Air below the sphere's centre (the plume's side), in diameters")
-              .def(4.0)
-              .at_least(1)
-              .at_most(20),
-          number("above", "Air above the sphere's centre, in diameters").def(2.0).at_least(1).at_most(20),
-          number("face_exchange_time",
-                 "tau of the sides' relaxation toward T_inf (air.face_exchange_time); 0: a closed box")
-              .in("s")
-              .def(0.5)
-              .at_least(0),
-          number("time", "Simulated time").in("s").def(3.0).above(0).at_most(100),
-          number("average", "The last fraction of the run the heat flux is averaged over")
-              .def(0.5)
-              .above(0)
-              .at_most(1),
-          integer("samples", "Heat-flux samples over the averaging window")
-              .def(40)
-              .at_least(2)
-              .at_most(100000),
-          number("nusselt_gate", "Gate on |Nu - Nu_ref| / Nu_ref").def(0.2).above(0),
-          // As the cavity: Wendland C2 over 3 spacings and no-slip walls (Adami 2012).
-          solver_schema_with({{"pressure", "dfsph"},
-                              {"kernel", "wendland_c2"},
-                              {"support_ratio", 3.0},
-                              {"artificial_viscosity", 0.0},
-                              {"density_tolerance", 0.005},
-                              {"no_slip", "adami2012"},
-                              {"max_dt", 0.05}}),
-      });
-  return object("", std::move(fields));
+  return air_case_schema({
+      number("diameter", "D of the sphere").in("m").def(0.03).above(0).at_most(1),
+      number("sphere_temperature", "T_s, where the sphere is held")
+          .in("°C")
+          .def(0.0)
+          .above(-100)
+          .at_most(500),
+      number("air_temperature", "T_inf, the air's starting and reference temperature")
+          .in("°C")
+          .def(20.0)
+          .above(-100)
+          .at_most(500),
+      number("gravity", "g").in("m/s^2").def(9.81).above(0),
+      number("width", "The box's width and depth, in diameters").def(4.0).at_least(2).at_most(20),
+      number("below", "Air below the sphere's centre (the plume's side), in diameters")
+          .def(4.0)
+          .at_least(1)
+          .at_most(20),
+      number("above", "Air above the sphere's centre, in diameters").def(2.0).at_least(1).at_most(20),
+      number("face_exchange_time",
+             "tau of the sides' relaxation toward T_inf (air.face_exchange_time); 0: a closed box")
+          .in("s")
+          .def(0.5)
+          .at_least(0),
+      number("time", "Simulated time").in("s").def(3.0).above(0).at_most(100),
+      number("average", "The last fraction of the run the heat flux is averaged over")
+          .def(0.5)
+          .above(0)
+          .at_most(1),
+      integer("samples", "Heat-flux samples over the averaging window").def(40).at_least(2).at_most(100000),
+      number("nusselt_gate", "Gate on |Nu - Nu_ref| / Nu_ref").def(0.2).above(0),
+      // As the cavity: Wendland C2 over 3 spacings and no-slip walls (Adami 2012).
+      solver_schema_with({{"pressure", "dfsph"},
+                          {"kernel", "wendland_c2"},
+                          {"support_ratio", 3.0},
+                          {"artificial_viscosity", 0.0},
+                          {"density_tolerance", 0.005},
+                          {"no_slip", "adami2012"},
+                          {"max_dt", 0.05}}),
+  });
 }
 
 }  // namespace
@@ -101,38 +94,16 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   if (settings["reference_speed"].get<double>() == 0.0)
     settings["reference_speed"] = std::sqrt(g * beta * dT * D);
 
-  Json doc = {
-      {"name", "validation/air-sphere"},
-      {"domain",
-       {{"min", {0.0, 0.0, 0.0}},
-        {"max", {2 * half_w, 2 * half_w, below + above}},
-        {"walls", {"-x", "+x", "-y", "+y", "-z", "+z"}},
-        {"wall_material", "insulator"}}},
-      {"gravity", {0.0, 0.0, -g}},
-      {"spacing", dx},
-      {"solver", settings},
-      {"ambient", {{"temperature", Tinf}}},
-      {"materials",
-       {{"air", air_material(prm)},
-        {"insulator", air_insulator(prm)},
-        // Conducting like the air, so the air's temperature is T_s at the sphere's surface (the cavity's
-        // held walls do the same).
-        {"sphere", {{"kind", "solid"}, {"density", rho}, {"conductivity", k}, {"specific_heat", c}}}}},
-      {"air",
-       {{"material", "air"},
-        {"temperature", Tinf},
-        {"buoyancy", "boussinesq"},
-        {"reference_temperature", Tinf},
-        {"expansion", beta},
-        {"face_exchange_time", prm["face_exchange_time"]}}},
-      {"solids",
-       {{{"shape", "sphere"},
-         {"material", "sphere"},
-         {"centre", {centre.x(), centre.y(), centre.z()}},
-         {"radius", 0.5 * D},
-         {"temperature", Ts},
-         {"hold_temperature", true}}}},
-  };
+  // The sphere of the conductor, so the air's temperature is T_s at its surface (as the cavity's walls).
+  Json doc = convection_scene("validation/air-sphere", {2 * half_w, 2 * half_w, below + above},
+                              {"-x", "+x", "-y", "+y", "-z", "+z"}, g, dx, settings, Tinf, beta, true, prm);
+  doc["air"]["face_exchange_time"] = prm["face_exchange_time"];
+  doc["solids"] = {{{"shape", "sphere"},
+                    {"material", "conductor"},
+                    {"centre", {centre.x(), centre.y(), centre.z()}},
+                    {"radius", 0.5 * D},
+                    {"temperature", Ts},
+                    {"hold_temperature", true}}};
   const Scene scene = scene_from_json(doc);
   int held = -1;
   for (std::size_t m = 0; m < scene.materials.size(); ++m)

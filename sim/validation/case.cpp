@@ -76,11 +76,12 @@ Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaul
   return f;
 }
 
-std::vector<Field> air_property_fields() {
-  return {number("density", "rho of the air").in("kg/m^3").def(1.2).above(0),
-          number("viscosity", "mu of the air").in("Pa s").def(1.8e-5).above(0),
-          number("conductivity", "k of the air").in("W/m/K").def(0.025).above(0),
-          number("specific_heat", "c of the air").in("J/kg/K").def(1006.0).above(0)};
+Field air_case_schema(std::vector<Field> own) {
+  own.push_back(number("density", "rho of the air").in("kg/m^3").def(1.2).above(0));
+  own.push_back(number("viscosity", "mu of the air").in("Pa s").def(1.8e-5).above(0));
+  own.push_back(number("conductivity", "k of the air").in("W/m/K").def(0.025).above(0));
+  own.push_back(number("specific_heat", "c of the air").in("J/kg/K").def(1006.0).above(0));
+  return object("", std::move(own));
 }
 
 Json air_material(const Json& params) {
@@ -97,6 +98,39 @@ Json air_insulator(const Json& params) {
           {"conductivity", 0.0},
           {"specific_heat", params["specific_heat"]},
           {"adiabatic", true}};
+}
+
+Json convection_scene(const std::string& name, const Eigen::Vector3d& max, const Json& walls, double g,
+                      double dx, const Json& solver, double temperature, double beta, bool buoyant,
+                      const Json& params) {
+  return {
+      {"name", name},
+      {"domain",
+       {{"min", {0.0, 0.0, 0.0}},
+        {"max", {max.x(), max.y(), max.z()}},
+        {"walls", walls},
+        {"wall_material", "insulator"}}},
+      {"gravity", {0.0, 0.0, -g}},
+      {"spacing", dx},
+      {"solver", solver},
+      {"ambient", {{"temperature", temperature}}},
+      {"materials",
+       {{"air", air_material(params)},
+        // Adiabatic, the air beside it conducting along it as in bulk (heat.cl).
+        {"insulator", air_insulator(params)},
+        {"conductor",
+         {{"kind", "solid"},
+          {"density", params["density"]},
+          {"conductivity", params["conductivity"]},
+          {"specific_heat", params["specific_heat"]}}}}},
+      {"air",
+       {{"material", "air"},
+        {"temperature", temperature},
+        {"buoyancy", buoyant ? "boussinesq" : "none"},
+        {"reference_temperature", temperature},
+        {"expansion", beta}}},
+      {"solids", Json::array()},
+  };
 }
 
 Line least_squares_line(const std::vector<double>& x, const std::vector<double>& y,

@@ -62,12 +62,19 @@ double churchill_sphere_nusselt(double rayleigh, double prandtl);
 }  // namespace thaw
 
 namespace thaw {
-// The properties of a case's air (rho 1.2, mu 1.8e-5, k 0.025, c 1006 by default): density, viscosity,
-// conductivity, specific_heat; and the air material they make.
-std::vector<Field> air_property_fields();
+// A case's parameter schema: its own fields, then the properties of its air (rho 1.2, mu 1.8e-5, k 0.025,
+// c 1006 by default: density, viscosity, conductivity, specific_heat); and the air material they make.
+Field air_case_schema(std::vector<Field> own);
 Json air_material(const Json& params);
 // An adiabatic solid with the air's density and specific heat (walls that pass no heat, sim/kernels/heat.cl).
 Json air_insulator(const Json& params);
+// The scene a natural-convection case starts from: the box [0, max] of air at `temperature` (also the
+// ambient and, with expansion beta, the Boussinesq reference; buoyancy "none" unless `buoyant`), the
+// given walls of air_insulator, gravity -g along z, and a material "conductor" that conducts like the air,
+// so that held solids made of it put the air beside them at their temperature. No solids yet.
+Json convection_scene(const std::string& name, const Eigen::Vector3d& max, const Json& walls, double g,
+                      double dx, const Json& solver, double temperature, double beta, bool buoyant,
+                      const Json& params);
 
 // solver_schema() with some defaults changed, for a case that needs other solver defaults.
 Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaults);

@@ -31,61 +31,54 @@ constexpr double kUmax[] = {3.649, 16.178, 34.73, 64.63};
 constexpr double kWmax[] = {3.697, 19.617, 68.59, 219.36};
 
 Field params() {
-  std::vector<Field> fields = air_property_fields();
-  fields.insert(
-      fields.begin(),
-      {
-          number("rayleigh", "Ra = g beta dT L^3 / (nu alpha); the cavity's side L follows from it")
-              .def(1e4)
-              .at_least(1e3)
-              .at_most(1e6),
-          number("temperature_difference", "dT between the hot and the cold wall")
-              .in("K")
-              .def(10.0)
-              .above(0)
-              .at_most(100),
-          number("mean_temperature", "T_mean, the air's starting and reference temperature T0")
-              .in("°C")
-              .def(20.0)
-              .above(-100)
-              .at_most(500),
-          choice("buoyancy", {"boussinesq", "none"}, "none: no flow, pure conduction (reference Nu = 1)")
-              .def("boussinesq"),
-          number("gravity", "g").in("m/s^2").def(9.81).above(0),
-          integer("depth", "Particles across the periodic depth (at least 3 kernel supports)")
-              .def(9)
-              .at_least(3)
-              .at_most(64),
-          number("time",
-                 "Simulated time, in diffusion times L^2 / alpha; 0 = 0.6 (Ra / 1e3)^(-1/4), which settles "
-                 "the flow (the stratified core fills in a time that falls as Ra^(-1/4))")
-              .def(0.0)
-              .at_least(0)
-              .at_most(10),
-          number("average", "The last fraction of the run the Nusselt number and speeds are averaged over")
-              .def(0.25)
-              .above(0)
-              .at_most(1),
-          integer("samples", "Heat-flux samples over the averaging window")
-              .def(40)
-              .at_least(2)
-              .at_most(100000),
-          number("nusselt_gate", "Gate on |Nu - Nu_ref| / Nu_ref").def(0.03).above(0),
-          number("speed_gate", "Gate on the largest mid-line speeds against the benchmark's, relative")
-              .def(0.1)
-              .above(0),
-          // Wendland C2 over 3 spacings: with the cubic spline over 2 the circulation at Ra 1e3 (res 20)
-          // ran 15-20 % slow and Nu - 1 was 60 % of the benchmark's; with Wendland both within 5 %.
-          solver_schema_with({{"pressure", "dfsph"},
-                              {"kernel", "wendland_c2"},
-                              {"support_ratio", 3.0},
-                              {"periodic", Json::array({"y"})},
-                              {"artificial_viscosity", 0.0},
-                              {"density_tolerance", 0.005},
-                              {"no_slip", "adami2012"},
-                              {"max_dt", 0.05}}),
-      });
-  return object("", std::move(fields));
+  return air_case_schema({
+      number("rayleigh", "Ra = g beta dT L^3 / (nu alpha); the cavity's side L follows from it")
+          .def(1e4)
+          .at_least(1e3)
+          .at_most(1e6),
+      number("temperature_difference", "dT between the hot and the cold wall")
+          .in("K")
+          .def(10.0)
+          .above(0)
+          .at_most(100),
+      number("mean_temperature", "T_mean, the air's starting and reference temperature T0")
+          .in("°C")
+          .def(20.0)
+          .above(-100)
+          .at_most(500),
+      choice("buoyancy", {"boussinesq", "none"}, "none: no flow, pure conduction (reference Nu = 1)")
+          .def("boussinesq"),
+      number("gravity", "g").in("m/s^2").def(9.81).above(0),
+      integer("depth", "Particles across the periodic depth (at least 3 kernel supports)")
+          .def(9)
+          .at_least(3)
+          .at_most(64),
+      number("time",
+             "Simulated time, in diffusion times L^2 / alpha; 0 = 0.6 (Ra / 1e3)^(-1/4), which settles "
+             "the flow (the stratified core fills in a time that falls as Ra^(-1/4))")
+          .def(0.0)
+          .at_least(0)
+          .at_most(10),
+      number("average", "The last fraction of the run the Nusselt number and speeds are averaged over")
+          .def(0.25)
+          .above(0)
+          .at_most(1),
+      integer("samples", "Heat-flux samples over the averaging window").def(40).at_least(2).at_most(100000),
+      number("nusselt_gate", "Gate on |Nu - Nu_ref| / Nu_ref").def(0.03).above(0),
+      number("speed_gate", "Gate on the largest mid-line speeds against the benchmark's, relative")
+          .def(0.1)
+          .above(0),
+      // Wendland C2 over 3 spacings: with the cubic spline over 2 the circulation at Ra 1e3 (res 20)
+      // ran 15-20 % slow and Nu - 1 was 60 % of the benchmark's; with Wendland both within 5 %.
+      solver_schema_with({{"pressure", "dfsph"},
+                          {"kernel", "wendland_c2"},
+                          {"support_ratio", 3.0},
+                          {"periodic", Json::array({"y"})},
+                          {"artificial_viscosity", 0.0},
+                          {"density_tolerance", 0.005},
+                          {"no_slip", "adami2012"},
+                          {"max_dt", 0.05}}),
+  });
 }
 
 // A column of the benchmark's table at Ra (Pr 0.71): a power law between neighbouring tabulated points.
@@ -158,31 +151,10 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
     settings["reference_speed"] = std::sqrt(g * beta * dT * L);
   const double Th = Tm + 0.5 * dT, Tc = Tm - 0.5 * dT;
 
-  Json doc = {
-      {"name", "validation/cavity"},
-      {"domain",
-       {{"min", {0.0, 0.0, 0.0}},
-        {"max", {L, D, L}},
-        {"walls", {"-z", "+z"}},
-        {"wall_material", "insulator"}}},
-      {"gravity", {0.0, 0.0, -g}},
-      {"spacing", dx},
-      {"solver", settings},
-      {"ambient", {{"temperature", Tm}}},
-      {"materials",
-       {{"air", air_material(prm)},
-        // Floor and ceiling: adiabatic, the air beside them conducting along them as in bulk (heat.cl).
-        {"insulator", air_insulator(prm)},
-        // The held walls conduct like the air, so the air's temperature is T_w at the wall's plane.
-        {"wall", {{"kind", "solid"}, {"density", rho}, {"conductivity", k}, {"specific_heat", c}}}}},
-      {"air",
-       {{"material", "air"},
-        {"temperature", Tm},
-        {"buoyancy", buoyant ? "boussinesq" : "none"},
-        {"reference_temperature", Tm},
-        {"expansion", beta}}},
-      {"solids", Json::array()},
-  };
+  // Floor and ceiling of the insulator; the held walls of the conductor, so the air's temperature is T_w
+  // at the wall's plane.
+  Json doc =
+      convection_scene("validation/cavity", {L, D, L}, {"-z", "+z"}, g, dx, settings, Tm, beta, buoyant, prm);
   // The held walls span the cavity's height only: a wall reaching past the floor would warm the corner's
   // air through the floor's corner as well. Insulating blocks fill the four corners behind the floor and
   // ceiling, so each air particle near a corner sees a full boundary.
@@ -191,7 +163,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
     return Json{
         {"shape", "box"}, {"material", material}, {"box", {{"min", {x0, 0.0, z0}}, {"max", {x1, D, z1}}}}};
   };
-  Json hot_wall = block("wall", -w, 0.0, 0.0, L), cold_wall = block("wall", L, L + w, 0.0, L);
+  Json hot_wall = block("conductor", -w, 0.0, 0.0, L), cold_wall = block("conductor", L, L + w, 0.0, L);
   hot_wall["temperature"] = Th;
   cold_wall["temperature"] = Tc;
   hot_wall["hold_temperature"] = cold_wall["hold_temperature"] = true;

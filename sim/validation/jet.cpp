@@ -23,47 +23,43 @@ namespace thaw {
 namespace {
 
 Field params() {
-  std::vector<Field> fields = air_property_fields();
-  fields.insert(
-      fields.begin(),
-      {
-          number("nozzle_diameter", "D").in("m").def(0.02).above(0).at_most(1),
-          number("speed", "v at the nozzle").in("m/s").def(2.0).above(0).at_most(50),
-          number("temperature", "T_j at the nozzle").in("°C").def(60.0).above(-100).at_most(500),
-          number("ambient_temperature", "T_inf of the room").in("°C").def(20.0).above(-100).at_most(500),
-          // One diameter: further on the jet mixes with the room faster than a real one does (at res 6,
-          // 2 D downstream: mass and enthalpy flow 15 % short, docs/VALIDATION-RESULTS.md).
-          number("plane", "Where the fluxes are measured, in D downstream of the nozzle")
-              .def(1.0)
-              .above(0)
-              .at_most(4),
-          number("disc", "Radius of the measuring disc about the axis, in D").def(1.0).above(0).at_most(1.5),
-          number("slab", "Thickness of the slab the fluxes are summed over, in spacings").def(4.0).above(0),
-          number("length", "Box length, in D (the nozzle stands 1 D from the back wall)")
-              .def(10.0)
-              .at_least(4)
-              .at_most(20),
-          // 5 D: in a box 3 D wide the air the jet drives round comes back warm through the measuring disc
-          // before the window ends (res 6: mass and enthalpy flow 6 % short at 1 D).
-          number("width", "Box width and height, in D").def(5.0).at_least(2).at_most(10),
-          // The starting jet's head moves at about a third of v: it has passed 1 D well before 8 D / v.
-          number("start", "Averaging starts, in D / v after the dryer starts").def(8.0).at_least(0),
-          number("stop", "and stops").def(14.0).above(0),
-          integer("samples", "Flux samples over the window").def(40).at_least(2).at_most(100000),
-          number("flux_gate", "Gate on each flux against the nozzle's, relative").def(0.03).above(0),
-          number("books_gate", "Gate on the energy closure and the mass books, relative to what came in")
-              .def(1e-6)
-              .above(0),
-          // The cubic spline over 2 spacings: at res 6 within 1.3 % in 19 s against Wendland C2 over 3
-          // (the cavity's kernel: slow flows need it) within 2.1 % in 52 s.
-          solver_schema_with({{"pressure", "dfsph"},
-                              {"kernel", "cubic_spline"},
-                              {"support_ratio", 2.0},
-                              {"artificial_viscosity", 0.0},
-                              {"density_tolerance", 0.005},
-                              {"max_dt", 0.01}}),
-      });
-  return object("", std::move(fields));
+  return air_case_schema({
+      number("nozzle_diameter", "D").in("m").def(0.02).above(0).at_most(1),
+      number("speed", "v at the nozzle").in("m/s").def(2.0).above(0).at_most(50),
+      number("temperature", "T_j at the nozzle").in("°C").def(60.0).above(-100).at_most(500),
+      number("ambient_temperature", "T_inf of the room").in("°C").def(20.0).above(-100).at_most(500),
+      // One diameter: further on the jet mixes with the room faster than a real one does (at res 6,
+      // 2 D downstream: mass and enthalpy flow 15 % short, docs/VALIDATION-RESULTS.md).
+      number("plane", "Where the fluxes are measured, in D downstream of the nozzle")
+          .def(1.0)
+          .above(0)
+          .at_most(4),
+      number("disc", "Radius of the measuring disc about the axis, in D").def(1.0).above(0).at_most(1.5),
+      number("slab", "Thickness of the slab the fluxes are summed over, in spacings").def(4.0).above(0),
+      number("length", "Box length, in D (the nozzle stands 1 D from the back wall)")
+          .def(10.0)
+          .at_least(4)
+          .at_most(20),
+      // 5 D: in a box 3 D wide the air the jet drives round comes back warm through the measuring disc
+      // before the window ends (res 6: mass and enthalpy flow 6 % short at 1 D).
+      number("width", "Box width and height, in D").def(5.0).at_least(2).at_most(10),
+      // The starting jet's head moves at about a third of v: it has passed 1 D well before 8 D / v.
+      number("start", "Averaging starts, in D / v after the dryer starts").def(8.0).at_least(0),
+      number("stop", "and stops").def(14.0).above(0),
+      integer("samples", "Flux samples over the window").def(40).at_least(2).at_most(100000),
+      number("flux_gate", "Gate on each flux against the nozzle's, relative").def(0.03).above(0),
+      number("books_gate", "Gate on the energy closure and the mass books, relative to what came in")
+          .def(1e-6)
+          .above(0),
+      // The cubic spline over 2 spacings: at res 6 within 1.3 % in 19 s against Wendland C2 over 3
+      // (the cavity's kernel: slow flows need it) within 2.1 % in 52 s.
+      solver_schema_with({{"pressure", "dfsph"},
+                          {"kernel", "cubic_spline"},
+                          {"support_ratio", 2.0},
+                          {"artificial_viscosity", 0.0},
+                          {"density_tolerance", 0.005},
+                          {"max_dt", 0.01}}),
+  });
 }
 
 CaseResult run(ClRuntime& cl, const Json& prm, int res) {
@@ -107,12 +103,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   Solver solver(cl, scene, initial_state(scene));
   solver.warm_up();
   const std::size_t room = solver.size();  // ids below this are the room's air
-  double room_mass = 0;
-  {
-    const HostParticles p = solver.particles();
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (p.phase[i] == static_cast<std::uint8_t>(Phase::Air)) room_mass += double(p.position[i][3]);
-  }
+  const double room_mass = solver.particles().mass(Phase::Air);
   const double unit = D / v;
   const int samples = prm["samples"];
   const double slab = double(prm["slab"]) * dx, disc = double(prm["disc"]) * D;
@@ -140,18 +131,12 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   mass *= per;
   momentum *= per;
   enthalpy *= per;
-  const double area = 0.25 * M_PI * D * D;
-  const double m_ref = rho * area * v, p_ref = m_ref * v, h_ref = m_ref * (h_jet - h_inf);
+  const double m_ref = rho * scene.dryers[0].area() * v, p_ref = m_ref * v, h_ref = m_ref * (h_jet - h_inf);
 
   // The books: the energy budget (inflow and intake included) and the air's mass.
   const EnergyBudget& b = solver.energy_budget();
   const double closure = solver.total_enthalpy() - b.initial - b.heat_in();
-  double air_now = 0;
-  {
-    const HostParticles p = solver.particles();
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (p.phase[i] == static_cast<std::uint8_t>(Phase::Air)) air_now += double(p.position[i][3]);
-  }
+  const double air_now = solver.particles().mass(Phase::Air);
   const InflowBooks in = solver.inflow();
   const double mass_books = air_now - (room_mass + in.mass - solver.outflow().mass);
 
