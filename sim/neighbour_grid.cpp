@@ -76,6 +76,7 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   k_cell_keys_ = cl::Kernel(program, "cell_keys");
   if (intake_) {
     k_intake_flags_ = cl::Kernel(program, "intake_flags");
+    k_set_flags_ = cl::Kernel(program, "set_flags");
     k_pipe_drive_ = cl::Kernel(program, "pipe_drive");
   }
   k_hist_ = cl::Kernel(program, "radix_histogram");
@@ -102,6 +103,8 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   if (intake_) {
     intakes_ = buf(scene.dryers.size() * 4 * 16);
     take_ = buf(n);
+    listed_ = buf(4);
+    list_ = buf(n * 8);
   }
   soa_ = buf(std::size_t(layout.stride) * 7 * 4);
   // The padding past the last particle is read by masked lanes only; keep it finite anyway.
@@ -141,26 +144,36 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
     blowing_ = static_cast<cl_uint>(in.size() / 4);
     if (!in.empty()) q.enqueueWriteBuffer(intakes_, CL_TRUE, 0, in.size() * 16, in.data());
     if (!in.empty() && owed) {
+      q.enqueueFillBuffer(listed_, cl_uint(0), 0, 4);
       set_args(k_intake_flags_, store[f.position], store[f.velocity], store[f.phase], take_, intakes_,
-               static_cast<cl_uint>(in.size() / 4), n);
+               static_cast<cl_uint>(in.size() / 4), n, listed_, list_);
       launch(q, k_intake_flags_, layout_.n);
+      // Only the flagged come back (grid.cl): a few hundred near the nozzles, not a byte per particle.
+      cl_uint listed = 0;
+      q.enqueueReadBuffer(listed_, CL_TRUE, 0, 4, &listed);
+      flagged_.resize(listed);
+      if (listed > 0) q.enqueueReadBuffer(list_, CL_TRUE, 0, std::size_t(listed) * 8, flagged_.data());
       // Which to take in, in index order (the sort's, so a rerun chooses the same): every one flagged in
-      // a pipe or a mouth (it is in the discs' way), one in a housing while its dryer owes.
-      take_host_.resize(layout_.n);
-      q.enqueueReadBuffer(take_, CL_TRUE, 0, layout_.n, take_host_.data());
-      bool changed = false;
-      for (std::uint8_t& t : take_host_) {
-        if (!t) continue;
+      // a pipe or a mouth (it is in the discs' way), one in a housing while its dryer owes. Those left
+      // get their flags cleared.
+      std::sort(flagged_.begin(), flagged_.end(),
+                [](const cl_uint2& a, const cl_uint2& b) { return a.s[0] < b.s[0]; });
+      std::size_t left = 0;
+      for (const cl_uint2& e : flagged_) {
+        const cl_uint t = e.s[1];
         double& debt = (*owed)[std::size_t((t - 1) / 2)];
         if (t % 2 == 1 || debt >= 1.0) {
           debt -= 1.0;
           P.intakes = 1;
         } else {
-          t = 0;
-          changed = true;
+          flagged_[left++] = {{e.s[0], 0}};
         }
       }
-      if (changed) q.enqueueWriteBuffer(take_, CL_TRUE, 0, layout_.n, take_host_.data());
+      if (left > 0) {
+        q.enqueueWriteBuffer(list_, CL_TRUE, 0, left * 8, flagged_.data());
+        set_args(k_set_flags_, take_, list_, static_cast<cl_uint>(left));
+        launch(q, k_set_flags_, left);
+      }
     }
     set_args(k_cell_keys_, store[f.position], store[f.velocity], store[f.phase], keys_[0], order_[0], clamped,
              g, P, take_);

@@ -62,12 +62,12 @@ class NeighbourGrid {
   const ParticleLayout& layout_;
   GridInfo info_;
   bool intake_ = false;  // the scene has air dryers: the key pass takes in what their intakes hold
-  std::vector<std::uint8_t> take_host_;
+  std::vector<cl_uint2> flagged_;  // (index, flag) of the particles intake_flags listed
   std::uint32_t ncells_ = 0, sort_passes_ = 0, radix_bits_ = 8;
   cl_uint blowing_ = 0;  // air dryers blowing at the last build()
-  cl::Kernel k_pipe_drive_, k_intake_flags_, k_cell_keys_, k_hist_, k_chunk_counts_, k_scan_chunks_,
-      k_scan_tiles_, k_scatter_, k_starts_;
-  cl::Buffer keys_[2], order_[2], hist_, totals_, chunks_, cell_start_, soa_, intakes_, take_;
+  cl::Kernel k_pipe_drive_, k_intake_flags_, k_set_flags_, k_cell_keys_, k_hist_, k_chunk_counts_,
+      k_scan_chunks_, k_scan_tiles_, k_scatter_, k_starts_;
+  cl::Buffer keys_[2], order_[2], hist_, totals_, chunks_, cell_start_, soa_, intakes_, take_, listed_, list_;
 };
 
 }  // namespace thaw

@@ -20,10 +20,14 @@
  *         the pressure at the exit rose, and the jet carried 9 % more momentum than the nozzle gave it);
  *   body  the rest of -P - B <= s < 0, rho < r + dx: the dryer's housing, where it draws the room's air
  *         in (2k + 2), taken while the dryer owes particles (the host chooses, NeighbourGrid::build).
+ * Each flagged particle is also listed, (index, flag), at an atomically counted slot of `list`, so the host
+ * reads the few flagged rather than a byte per particle; it orders them by index (the slots' order
+ * varies from run to run, the choice must not) and clears the flags of those it leaves (set_flags).
  * cell_keys removes those whose flag the host leaves nonzero. */
 #ifdef THAW_INTAKE
 kernel void intake_flags(global const float4* pos, global const float4* vel, global const uchar* phase,
-                         global uchar* flag, global const float4* intake, const uint count, const uint n) {
+                         global uchar* flag, global const float4* intake, const uint count, const uint n,
+                         volatile global uint* listed, global uint2* list) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   uchar f = 0;
@@ -47,6 +51,13 @@ kernel void intake_flags(global const float4* pos, global const float4* vel, glo
     }
   }
   flag[i] = f;
+  if (f) list[atomic_inc(listed)] = (uint2)(i, f);
+}
+
+/* flag[list[j].x] = list[j].y for the host's m entries (its answer to intake_flags' list). */
+kernel void set_flags(global uchar* flag, global const uint2* list, const uint m) {
+  const uint j = get_global_id(0);
+  if (j < m) flag[list[j].x] = (uchar)list[j].y;
 }
 
 /* The pipes' air moves out at the exit speed (see above): run before the drift. */
