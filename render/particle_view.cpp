@@ -117,6 +117,9 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, cons
   std::vector<float> depth(std::size_t(cam.width) * cam.height, std::numeric_limits<float>::infinity());
   for (std::size_t i = 0; i < s.position.size(); ++i) {
     if (!o.solids && static_cast<Phase>(s.phase[i]) == Phase::Solid) continue;
+    // Coloured by a field, glass (a transparent solid) is clear, as in the surface view: a closed glass
+    // room or cup would otherwise hide all the air or water whose field was asked for.
+    if (by_t && !s.glass.empty() && s.glass[i]) continue;
     const Eigen::Vector4f c = view * s.position[i].homogeneous();
     const double z = -c.z();  // distance along the view direction
     if (z <= radius) continue;

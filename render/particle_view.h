@@ -23,7 +23,7 @@ struct ParticleViewOptions {
   // The scale [°C or m/s]; t_min == t_max: the particles' own range (for speed 0 to the fastest water or
   // air particle).
   double t_min = 0, t_max = 0;
-  bool solids = true;               // draw static solids (walls, plates)
+  bool solids = true;  // draw static solids (walls, plates); glass only when coloured by phase
 };
 
 struct ViewImage {

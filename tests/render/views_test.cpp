@@ -100,6 +100,18 @@ TEST(ParticleView, SpeedColoursRunFromStillToTheFastest) {
   EXPECT_GT(chroma(v.image.pixel(x, y)).dot(chroma(cool_warm(1.0))), 0.999);
   EXPECT_EQ(colour_bar_labels(0, 2.5, BarUnit::MetresPerSecond),
             (std::array<std::string, 3>{"2.50 m/s", "1.25 m/s", "0.00 m/s"}));
+  // Glass in front of them hides them by phase, not by speed: a field view sees through glass.
+  s.position.push_back(s.position[1] + Eigen::Vector3f(0.0f, -0.05f, 0.0f));  // nearer the camera
+  s.phase.push_back(static_cast<std::uint8_t>(Phase::Solid));
+  s.temperature.push_back(20.0f);
+  s.speed.push_back(0.0f);
+  s.glass = {0, 0, 1};
+  project(cam, s.position[1], x, y);
+  EXPECT_GT(chroma(render_particles(s, cam, o).image.pixel(x, y)).dot(chroma(cool_warm(1.0))), 0.999);
+  ParticleViewOptions by_phase;
+  EXPECT_GT(chroma(render_particles(s, cam, by_phase).image.pixel(x, y))
+                .dot(chroma(phase_rgb(static_cast<std::uint8_t>(Phase::Solid)))),
+            0.999);
   // Without velocities there is nothing to colour by.
   s.speed.clear();
   EXPECT_THROW(render_particles(s, cam, o), Error);
