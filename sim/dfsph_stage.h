@@ -85,6 +85,7 @@ class DfsphStage {
   float support_ = 0;
   cl_uint min_neighbours_ = 0;
   double rest_density_ = 1000;
+  double error_scale_ = 1000;  // the errors' unit: rho0 (kg/m^3), or 1 where they are fractions
   double density_tolerance_ = 0, divergence_tolerance_ = 0;
   int max_iterations_ = 100;
   cl::Kernel k_columns_, k_error_, k_warm_, k_correct_, k_sum_, k_predict_, k_drift_, k_pressure_,

@@ -25,25 +25,7 @@ fluid::MaterialFlow flow_row(const SolverSettings& s, float rest_density, float 
 
 std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k,
                                                      bool with_heat) {
-  // Fluid blocks, then emitters: each names its path for the message.
-  std::vector<std::pair<int, std::string>> users;
-  for (std::size_t b = 0; b < scene.fluids.size(); ++b)
-    users.emplace_back(scene.fluids[b].material, "fluids[" + std::to_string(b) + "].material");
-  for (std::size_t e = 0; e < scene.emitters.size(); ++e)
-    users.emplace_back(scene.emitters[e].material, "emitters[" + std::to_string(e) + "].material");
-  if (scene.has_air()) users.emplace_back(scene.air.material, "air.material");
-  int first = -1;
-  for (const auto& [m, path] : users) {
-    if (first >= 0 && scene.materials[m].density != scene.materials[first].density)
-      throw SceneError(path, "fluids of two rest densities ('" + scene.materials[m].name + "' " +
-                                 format_number(scene.materials[m].density) + " kg/m^3, '" +
-                                 scene.materials[first].name + "' " +
-                                 format_number(scene.materials[first].density) +
-                                 " kg/m^3) need the multiphase boundaries and time step of the air model, "
-                                 "which this build does not have yet; give every fluid block and emitter the "
-                                 "same rest density");
-    if (first < 0) first = m;
-  }
+  check_multiphase(scene);  // a scene built in code has not been through the loader's check
   std::vector<fluid::MaterialFlow> table;
   for (const Material& m : scene.materials) {
     // A boundary material carries rho0 V of the fluid it bounds: the fluid's row (Akinci 2012).

@@ -26,10 +26,9 @@ struct SolverConstants;
 fluid::MaterialFlow flow_row(const SolverSettings& s, float rest_density, float kinematic_viscosity,
                              float sound_speed, float smoothing);
 
-// Each material's flow properties, one per Scene::materials (fluid_params.h). Throws SceneError naming
-// the fluid block when the scene has fluids of two rest densities: the passes take them from the table,
-// but the boundaries (Akinci 2012) and the time step still assume one fluid until the multiphase air
-// model lands. `with_heat`: the heat stage runs, so Boussinesq air reads its temperature (THAW_BUOYANCY);
+// Each material's flow properties, one per Scene::materials (fluid_params.h). Fluids of several rest
+// densities need DFSPH's multiphase form (check_multiphase throws SceneError at solver.pressure
+// otherwise). `with_heat`: the heat stage runs, so Boussinesq air reads its temperature (THAW_BUOYANCY);
 // without it the air's buoyancy is the constant of its starting temperature.
 std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k,
                                                      bool with_heat = false);

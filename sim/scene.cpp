@@ -46,6 +46,9 @@ const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph"
 const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
 const char* name(ExposedArea) { return "iwasaki2010"; }
 const char* name(DfsphBoundary b) { return b == DfsphBoundary::Akinci2012 ? "akinci2012" : "adami2012"; }
+const char* name(Multiphase m) {
+  return m == Multiphase::DomaradzkiMartyn ? "domaradzki_martyn" : "hu_adams2006";
+}
 const char* name(NoSlip n) { return n == NoSlip::Adami2012 ? "adami2012" : "none"; }
 const char* name(DryerModel m) { return m == DryerModel::Air ? "air" : "cone"; }
 
@@ -501,6 +504,8 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     check_emitter(s.emitters.back(), s, path);
   }
 
+  check_multiphase(s);
+
   for (int a = 0; a < 3; ++a) {
     if (!s.solver.periodic[static_cast<std::size_t>(a)]) continue;
     const std::string axis(1, kAxis[static_cast<std::size_t>(a)]);
@@ -808,6 +813,8 @@ SolverSettings solver_settings_from_json(const Json& j) {
   s.divergence_warm_start = j["divergence_warm_start"].get<bool>();
   s.boundary_pressure =
       choice_of<DfsphBoundary>(j["boundary_pressure"], {DfsphBoundary::Adami2012, DfsphBoundary::Akinci2012});
+  s.multiphase =
+      choice_of<Multiphase>(j["multiphase"], {Multiphase::HuAdams2006, Multiphase::DomaradzkiMartyn});
   s.eos = choice_of<Eos>(j["eos"], {Eos::Tait, Eos::Linear});
   s.gamma = j["gamma"].get<double>();
   s.speed_of_sound = j["speed_of_sound"].get<double>();
@@ -854,6 +861,38 @@ void apply_override(Json& doc, const std::string& assignment, const Field& schem
     throw SceneError(path, "number " + text + " is out of range");
   }
   set_at_path(doc, path, std::move(value), &schema);
+}
+
+void check_multiphase(const Scene& s) {
+  if (s.solver.flow && s.multiphase() && s.solver.pressure != PressureSolver::Dfsph)
+    throw SceneError("solver.pressure",
+                     "fluids of several rest densities (air beside water, or beside the water the ice melts "
+                     "into) need 'dfsph', whose multiphase form (Hu & Adams 2006) holds at the real density "
+                     "ratio; 'wcsph' has one rest density");
+}
+
+std::vector<double> Scene::fluid_rest_densities() const {
+  std::vector<double> rest;
+  auto add = [&](int m) {
+    if (m >= 0) rest.push_back(materials[static_cast<std::size_t>(m)].density);
+  };
+  for (const auto& f : fluids) add(f.material);
+  for (const auto& e : emitters) add(e.material);
+  for (const auto& c : ice) add(materials[static_cast<std::size_t>(c.material)].partner);
+  if (has_air()) add(air.material);
+  return rest;
+}
+
+bool Scene::multiphase() const {
+  const auto rest = fluid_rest_densities();
+  return std::any_of(rest.begin(), rest.end(), [&](double d) { return d != rest.front(); });
+}
+
+double Scene::rest_density_split() const {
+  const auto rest = fluid_rest_densities();
+  if (rest.empty()) return 0;
+  const auto [lo, hi] = std::minmax_element(rest.begin(), rest.end());
+  return *lo == *hi ? 0.5 * *lo : std::sqrt(*lo * *hi);
 }
 
 Scene scene_from_json(Json doc, const std::vector<std::string>& overrides, const std::string& folder) {

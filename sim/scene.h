@@ -36,6 +36,8 @@ enum class PressureSolver { Wcsph, Dfsph };
 enum class BoundaryVolume { Lattice, Akinci2012 };
 // DFSPH: the pressure boundary particles take in the solves (sim/kernels/dfsph.cl).
 enum class DfsphBoundary { Adami2012, Akinci2012 };
+// How fluids of several rest densities meet (dfsph, sim/kernels/dfsph.cl).
+enum class Multiphase { HuAdams2006, DomaradzkiMartyn };
 enum class ExposedArea { Iwasaki2010 };
 // How walls hold the fluid's tangential velocity: only through boundary_viscosity, or no-slip.
 enum class NoSlip { None, Adami2012 };
@@ -51,6 +53,7 @@ const char* name(PressureSolver p);  // "wcsph", "dfsph"
 const char* name(BoundaryVolume b);  // "lattice", "akinci"
 const char* name(ExposedArea a);     // "iwasaki2010" (also the heat pass's function suffix)
 const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
+const char* name(Multiphase m);      // "hu_adams2006", "domaradzki_martyn"
 const char* name(NoSlip n);          // "none", "adami2012"
 const char* name(DryerModel m);      // "cone", "air"
 
@@ -186,6 +189,7 @@ struct SolverSettings {
   double pressure_relaxation = 0.5;     // dfsph: the relaxed Jacobi's omega (sim/kernels/dfsph.cl)
   bool divergence_warm_start = false;   // dfsph: the divergence solve starts from last step's kappa
   DfsphBoundary boundary_pressure = DfsphBoundary::Adami2012;  // dfsph: extrapolated, or none (one-sided)
+  Multiphase multiphase = Multiphase::HuAdams2006;             // dfsph, air beside water
   Eos eos = Eos::Tait;
   double gamma = 7.0;                  // Tait exponent
   double speed_of_sound = 0.0;         // [m/s]; 0 = sound_speed_factor * reference_speed
@@ -235,6 +239,14 @@ struct Scene {
   bool has_air() const { return air.material >= 0; }
   // How many dryers blow air particles (dryers[].model "air").
   std::size_t air_dryer_count() const;
+  // Fluids of more than one rest density can meet: air beside water, or beside the water ice melts into.
+  // The fluid passes are then built with the number-density multiphase form (sim/kernels/dfsph.cl).
+  bool multiphase() const;
+  // Between the light fluids' rest densities and the heavy ones' (their geometric mean): the multiphase
+  // passes tell air from water by it.
+  double rest_density_split() const;
+  // The rest densities of every fluid the scene has or makes (blocks, emitters, melted ice, air).
+  std::vector<double> fluid_rest_densities() const;
   std::vector<IceBlock> ice;
   std::vector<Solid> solids;
   HeatSettings heat;
@@ -297,6 +309,10 @@ Scene load_scene(const std::string& file, const std::vector<std::string>& overri
 // Same from an in-memory document (used by validation cases and tests). A relative `mesh` path is looked
 // for in `folder` (the scene file's; empty: the working directory), then in configs/ of the source tree;
 // the Scene's `source` holds the path it was found at.
+// Refuses a scene whose fluids of several rest densities meet under a solver without a multiphase form,
+// at solver.pressure.
+void check_multiphase(const Scene& scene);
+
 Scene scene_from_json(Json doc, const std::vector<std::string>& overrides = {},
                       const std::string& folder = "");
 

@@ -55,6 +55,16 @@ const Field& solver_schema() {
               "akinci2012 = none, the fluid's own pressure one-sided (Akinci et al. 2012, as Bender & "
               "Koschier 2017 use it), which carries half and lets water sink into walls (for comparison)")
               .def("adami2012"),
+          choice(
+              "multiphase", {"hu_adams2006", "domaradzki_martyn"},
+              "dfsph, fluids of several rest densities (air beside water): hu_adams2006 = each particle's "
+              "density from its neighbours' rest volumes and a pair pressure weighted by the other's "
+              "density (Hu & Adams 2006's inter-particle pressure), so the water's pressure does not push "
+              "the light air, with the harmonic mean of the viscosities; holds air still over water at the "
+              "real ratio (thaw validate air-water). domaradzki_martyn = the paper's choices (Domaradzki & "
+              "Martyn sec. 6.1): the pair's mean pressure, the viscosities' arithmetic mean (eq 5) and no "
+              "suction at the interface (eq 6); meant for their air 10x lighter than water, for comparison")
+              .def("hu_adams2006"),
           choice("eos", {"tait", "linear"}, "Equation of state: Tait (stiff) or linear in density")
               .def("tait"),
           number("gamma", "Tait exponent").def(7.0).at_least(1).at_most(10),

@@ -203,6 +203,11 @@ std::string program_options(const Scene& scene) {
   const bool dfsph = scene.solver.pressure == PressureSolver::Dfsph;
   // DFSPH solves for the pressure: the density pass writes none (sim/kernels/density.cl).
   if (dfsph) opts << " -DTHAW_DFSPH";
+  // Air beside water: the number-density form in every pass that weighs neighbours (dfsph.cl).
+  if (dfsph && scene.multiphase())
+    opts << " -DTHAW_MULTIPHASE -DTHAW_MP_SPLIT=" << std::to_string(scene.rest_density_split()) << "f";
+  if (dfsph && scene.multiphase() && scene.solver.multiphase == Multiphase::DomaradzkiMartyn)
+    opts << " -DTHAW_MP_SYMMETRIC -DTHAW_VISC_ARITHMETIC_MEAN";
   if (scene.solver.eos == Eos::Tait && !dfsph) opts << " -DTHAW_EOS_TAIT";
   if (scene.solver.eos == Eos::Tait && scene.solver.gamma == 7.0) opts << " -DTHAW_GAMMA_7";
   if (wendland) opts << " -DTHAW_WENDLAND";
@@ -312,6 +317,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
     dfsph_ = std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow());
   if (dfsph_) fluid_->compute_dfsph_alpha(dfsph_->columns(), dfsph_->min_neighbours());
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
+  if (rigid_ && fluid_ && dfsph_ && scene_.multiphase()) rigid_->use_flow_table(fluid_->flow());
   forces_velocity_ = rigid_ && dfsph_
                          ? cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, layout_.capacity * sizeof(cl_float4))
                          : cl::Buffer();

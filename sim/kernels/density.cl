@@ -41,8 +41,14 @@ kernel void density(global const float4* pos, global const float* soa, global co
    * sum_j (fluid) m_j |grad W_ij|^2, the neighbour count; a boundary particle only learns whether fluid is
    * within reach (the fluid masses FM, written by dfsph_columns before this pass). */
   global const float* FM = col + COL_FM * stride;
+#ifdef THAW_MULTIPHASE
+  global const float* VOL = col + COL_VOL * stride;
+#endif
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f), s = (floatV)(0.0f);
   floatV count = (floatV)(0.0f);
+#ifdef THAW_MULTIPHASE
+  floatV hx = (floatV)(0.0f), hy = (floatV)(0.0f), hz = (floatV)(0.0f);
+#endif
 #endif
 #ifdef THAW_NO_SLIP
   /* A boundary particle's Shepard average of the fluid's velocity around it (Adami et al. 2012 eq 22). */
@@ -60,7 +66,15 @@ kernel void density(global const float4* pos, global const float* soa, global co
       const floatV r2 = dx * dx + dy * dy + dz * dz;
       /* Lanes past the row's end, or outside the support, add nothing (a select, not a branch). */
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+#ifdef THAW_MULTIPHASE
+      /* Fluids of several rest densities (Hu & Adams 2006; Solenthaler & Pajarola 2008): each particle
+       * counts its neighbours' rest volumes V_j (dfsph_columns), not their masses, and takes
+       * rho_i = rho0_i sum_j V_j W_ij, so water next to air (830x lighter) is not read as under-dense nor
+       * the air beside it as 400x over-dense. */
+      const floatV m = vloadV(0, VOL + j);
+#else
       const floatV m = vloadV(0, M + j);
+#endif
       const floatV q = sqrt(r2) * inv_H;
       acc += select((floatV)(0.0f), m * w_shape(q), in);
 #ifdef THAW_NO_SLIP
@@ -84,13 +98,33 @@ kernel void density(global const float4* pos, global const float* soa, global co
         gx += select((floatV)(0.0f), mg * dx, in);
         gy += select((floatV)(0.0f), mg * dy, in);
         gz += select((floatV)(0.0f), mg * dz, in);
+#ifdef THAW_MULTIPHASE
+        /* pi_i's share of the pair pressure (dfsph.cl): c_ij = 2 rho0_j / (rho0_i + rho0_j), rho0_j = V_j / FM_j
+         * for a fluid neighbour; for a boundary one 1, or 2 for the light fluid, whose walls mirror its own
+         * pressure (dfsph_correct). */
+        const floatV cb = (floatV)(rho0 < THAW_MP_SPLIT ? 2.0f : 1.0f);
+#ifdef THAW_MP_SYMMETRIC /* solver.multiphase domaradzki_martyn: the pair's mean pressure */
+        const floatV cw = select(cb, (floatV)(1.0f), fm > 0.0f);
+#else
+        const floatV cw = select(cb, 2.0f * m / (rho0 * fm + m), fm > 0.0f);
+#endif
+        hx += select((floatV)(0.0f), cw * mg * dx, in);
+        hy += select((floatV)(0.0f), cw * mg * dy, in);
+        hz += select((floatV)(0.0f), cw * mg * dz, in);
+        s += select((floatV)(0.0f), cw * fm * gf * gf * r2, in);
+#else
         s += select((floatV)(0.0f), fm * gf * gf * r2, in);
+#endif
         count += select((floatV)(0.0f), (floatV)(1.0f), in);
       }
 #endif
     }
   }
+#ifdef THAW_MULTIPHASE
+  const float rho = rho0 * THAW_SIGMA(H) * lanes_sum(acc);
+#else
   const float rho = THAW_SIGMA(H) * lanes_sum(acc);
+#endif
 #ifdef THAW_NO_SLIP
   /* The velocity the forces pass's viscous term gives each particle (blocks of `stride` floats): a
    * boundary particle's ghost 2 v_w - v~ (eq 23: the fluid's velocity mirrored through the wall moving with
@@ -116,9 +150,18 @@ kernel void density(global const float4* pos, global const float* soa, global co
     const float scale = THAW_SIGMA(H) * inv_H * inv_H;
     const float3 G = scale * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
     const float S = pi.w * scale * scale * lanes_sum(s);
+#ifdef THAW_MULTIPHASE
+    /* With rest volumes (dfsph.cl, multiphase): G_i = sum_j V_j grad W_ij, Gc_i = sum_j c_ij V_j grad W_ij,
+     * S_i = sum_j (fluid) c_ij V_j / rho0_j |grad W_ij|^2, and a pressure pi_i alone changes D r_i / Dt by
+     * -dt pi_i (Gc_i . G_i / rho0_i + V_i S_i). */
+    const float3 Gc = scale * (float3)(lanes_sum(hx), lanes_sum(hy), lanes_sum(hz));
+    const float d = dot(Gc, G) / rho0 + VOL[i] * S / pi.w;
+    const float alpha = d > 0.0f ? 1.0f / d : 0.0f;
+#else
     const float d = dot(G, G) + S;
     /* A particle without neighbours (d = 0) cannot be corrected by its own pressure: leave it alone. */
     const float alpha = d > 0.0f ? rho / d : 0.0f;
+#endif
     col[COL_AD * stride + i] = alpha;
     col[COL_AV * stride + i] = lanes_sum(count) - 1.0f >= (float)min_neighbours ? alpha : 0.0f; /* -1: itself */
   }
@@ -144,6 +187,17 @@ kernel void density(global const float4* pos, global const float* soa, global co
   const float dp = p / (rho * rho);
   density[i] = rho;
   state[i] = (float4)(rho, dp, boundary ? 1.0f : 0.0f, p);
+#if defined(THAW_MULTIPHASE)
+  /* Multiphase (forces.cl): a fluid particle's dynamic viscosity coefficient mu_j = k_j rho0_j, a boundary
+   * particle's kinematic one negated (the pair takes it at the fluid's own density, as in one fluid), and
+   * the volume m_j / rho_j, which the pair term weighs symmetrically (DFSPH: no pressure term there). */
+#ifdef THAW_NO_SLIP
+  derived[i] = boundary ? -mf.viscosity : mf.viscosity * rho0;
+#else
+  derived[i] = boundary ? -P.visc_boundary : mf.viscosity * rho0;
+#endif
+  derived[stride + i] = pi.w / rho;
+#else
 #ifdef THAW_NO_SLIP
   /* No-slip: a boundary pair takes the fluid's viscosity (the boundary material's row holds the fluid's). */
   derived[i] = mf.viscosity * pi.w / rho;
@@ -151,5 +205,6 @@ kernel void density(global const float4* pos, global const float* soa, global co
   derived[i] = (boundary ? P.visc_boundary : mf.viscosity) * pi.w / rho;
 #endif
   derived[stride + i] = pi.w * dp;
+#endif
   derived[2 * stride + i] = phase[i] == THAW_PHASE_SOLID ? pi.w : 0.0f;
 }

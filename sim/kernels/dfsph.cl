@@ -38,7 +38,25 @@
  *   ERR   this iteration's error: ρ* - ρ0 or Dρ/Dt (≥ 0; 0 for boundary particles)
  * and the saved field `kappa` (sim/dfsph_stage.cpp): the step's accumulated (Σ κ dt², Σ κ dt) of the two
  * solves, dt-free, which warm-start the next step's density solve (2017 §4.3; its divergence solve too
- * with solver.divergence_warm_start) and make a resumed run bitwise the same. */
+ * with solver.divergence_warm_start) and make a resumed run bitwise the same.
+ *
+ * Fluids of several rest densities (THAW_MULTIPHASE: air beside water, 1:830): the mass-weighted sums
+ * above read a water particle next to air as under-dense and the air beside it as hundreds of times
+ * over-dense. Multiphase builds use the number-density form of Hu & Adams 2006 (also Solenthaler &
+ * Pajarola 2008) with rest volumes V = m / ρ0 (column VOL): each particle's constraint is its own
+ * r_i = ρ_i / ρ0_i = Σ_j V_j W_ij = 1, whatever its neighbours weigh. The pressure of a pair is Hu & Adams
+ * 2006's inter-particle pressure, weighted by the other's density, 2 p_ij = c_ij π_i + (2 - c_ij) π_j with
+ * c_ij = 2 ρ0_j / (ρ0_i + ρ0_j) (π_i + π_j between fluids of one density; solver.multiphase
+ * domaradzki_martyn, THAW_MP_SYMMETRIC, keeps the plain sum), and F_ij = -V_i V_j 2 p_ij ∇W_ij, so
+ *   a_i = -(1/ρ0_i) Σ_j V_j 2 p_ij ∇W_ij,  D r_i/Dt = Σ_j V_j (v_i - v_j)·∇W_ij,
+ *   α_i = 1 / (Gc_i·G_i/ρ0_i + V_i S_i),  G_i = Σ_j V_j ∇W_ij,  Gc_i = Σ_j c_ij V_j ∇W_ij,
+ *   S_i = Σ_{j fluid} c_ij V_j/ρ0_j |∇W_ij|²  (density.cl),
+ *   density solve π_i = (r*_i - 1)⁺ α_i / dt², divergence solve π_i = (D r/Dt)⁺_i α_i / dt.
+ * KR then holds the pressure π itself, the errors are fractions (of each particle's own ρ0), FM holds
+ * V/ρ0 for fluid particles, and `kappa` accumulates π dt² and π dt. THAW_MP_SPLIT (a rest density
+ * between the fluids') tells the light fluid from the heavy one for the walls (dfsph_extrapolate,
+ * dfsph_correct). The weighted system is not symmetric and Jacobi is not sure to converge on it: see
+ * docs/VALIDATION-RESULTS.md (air-water) for where it holds. */
 
 /* Relaxed Jacobi (solver.pressure_relaxation, as IISPH's omega = 0.5, Ihmsen et al. 2014): each sweep
  * applies omega of the kappa that would zero a particle's own error. Unrelaxed (omega = 1), neighbours
@@ -72,17 +90,24 @@
 
 /* FM: who is fluid, as the lanes of the other passes (and the density pass's alpha) read it; run after the
  * grid's sort, before the density pass. */
-kernel void dfsph_columns(global const float4* pos, global const uchar* phase, global float* col, const uint stride,
-                          const uint n) {
+kernel void dfsph_columns(global const float4* pos, global const uchar* phase, global const uchar* material,
+                          global const MaterialFlow* flow, global float* col, const uint stride, const uint n) {
   const uint i = get_global_id(0);
   if (i >= n) return;
+#ifdef THAW_MULTIPHASE
+  const float rho0 = flow[material[i]].rest_density;
+  const float v = pos[i].w / rho0;
+  col[COL_VOL * stride + i] = v;
+  col[COL_FM * stride + i] = THAW_IS_STATIC(phase[i]) ? 0.0f : v / rho0;
+#else
   col[COL_FM * stride + i] = THAW_IS_STATIC(phase[i]) ? 0.0f : pos[i].w;
+#endif
   col[COL_KR * stride + i] = 0.0f;
 }
 
 /* Σ_j m_j (v_i - v_j)·∇W_ij over every neighbour (boundary particles move with their body or not at all). */
-float density_rate(const float4 pi, const float3 vi, global const float* soa, global const uint* cell_start,
-                   const Grid g, const float H, const uint stride) {
+float density_rate(const float4 pi, const float3 vi, global const float* soa, global const float* col,
+                   global const uint* cell_start, const Grid g, const float H, const uint stride) {
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
   DFSPH_SOA(soa, stride)
@@ -96,7 +121,11 @@ float density_rate(const float4 pi, const float3 vi, global const float* soa, gl
       DFSPH_LANES(pr, j, je, H2)
       const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
                         (vi.z - vloadV(0, VZ + j)) * dz;
+#ifdef THAW_MULTIPHASE
+      const floatV t = vloadV(0, col + COL_VOL * stride + j) * grad_shape(sqrt(r2) * inv_H) * vd; /* V_j */
+#else
       const floatV t = vloadV(0, M + j) * grad_shape(sqrt(r2) * inv_H) * vd;
+#endif
       acc += select((floatV)(0.0f), t, in);
     }
   }
@@ -114,7 +143,7 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
   if (THAW_IS_STATIC(phase[i])) return; /* their KR and ERR stay 0 (dfsph_columns, density.cl) */
   const float4 pi = pos[i];
   const float3 vi = (float3)(soa[4 * stride + i], soa[5 * stride + i], soa[6 * stride + i]);
-  const float rate = density_rate(pi, vi, soa, cell_start, g, H, stride);
+  const float rate = density_rate(pi, vi, soa, col, cell_start, g, H, stride);
   const float rho = density[i];
   float err, k;
   if (density_mode) {
@@ -125,8 +154,16 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
      * 0.17 m/s on average, and after 0.1 s its top 5 spacings were still under-dense (717-881 kg/m^3;
      * now 895 in the top one, then 1002-1003), and Iwasaki's neighbour count gave the air 6,875 exposed
      * faces of water (now 994; WCSPH 963), so the water lost 8x the heat to the air that WCSPH's did. */
+#ifdef THAW_MULTIPHASE
+    /* Fractions of the particle's own rest density (the header), compression only as in one fluid
+     * (Domaradzki & Martyn's eq 6 clamps the interface so too). Correcting expansion as well where the
+     * neighbourhood is full blew the air-over-water tank up within 50 steps: the Jacobi sweeps then
+     * pull the water's top layer into the air and back. */
+    err = fmax(rho / flow[material[i]].rest_density + dt * rate - THAW_DFSPH_LATTICE, 0.0f);
+#else
     const float rho0 = flow[material[i]].rest_density * THAW_DFSPH_LATTICE;
     err = fmax(rho + dt * rate - rho0, 0.0f);
+#endif
     k = err * fmax(col[COL_AD * stride + i], 0.0f) / (dt * dt); /* a boundary's flag, if it melted: 0 */
   } else {
     const float a = col[COL_AV * stride + i];
@@ -134,8 +171,13 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
     k = err * a / dt;
   }
   k *= THAW_OMEGA; /* relaxed Jacobi */
+#ifdef THAW_MULTIPHASE
+  col[COL_KR * stride + i] = k; /* the pressure π */
+  col[COL_ERR * stride + i] = fabs(err);
+#else
   col[COL_KR * stride + i] = k / rho;
   col[COL_ERR * stride + i] = err;
+#endif
 }
 
 /* A boundary particle's KR from the fluid around it (Adami et al. 2012, eq 27, the wall's acceleration
@@ -168,17 +210,35 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
       DFSPH_LANES(pr, j, je, H2)
+#ifdef THAW_MULTIPHASE
+      /* Shepard weights V_f W_bf over the heavy fluid only, KR the pressure itself: the light fluid
+       * (air) takes its own pressure for a wall's (dfsph_correct), and the water's wall pressure is not
+       * lowered by the air's beside it. rho0_j = V_j / FM_j. */
+      const floatV vj = vloadV(0, col + COL_VOL * stride + j), fmj = vloadV(0, FM + j);
+      const floatV w = select((floatV)(0.0f), vj, (fmj > 0.0f) & (fmj * THAW_MP_SPLIT <= vj)) *
+                       w_shape(sqrt(r2) * inv_H);
+      const floatV rho_j = vloadV(0, density + j);
+      floatV p = vloadV(0, KR + j);
+      if (hydrostatic) p += rho_j * (gravity.x * dx + gravity.y * dy + gravity.z * dz);
+      num += select((floatV)(0.0f), w * p, in);
+      den += select((floatV)(0.0f), w, in);
+#else
       const floatV w = vloadV(0, FM + j) * w_shape(sqrt(r2) * inv_H); /* 0 for boundary neighbours */
       const floatV rho_j = vloadV(0, density + j);
       floatV p = vloadV(0, KR + j) * rho_j * rho_j;
       if (hydrostatic) p += rho_j * (gravity.x * dx + gravity.y * dy + gravity.z * dz);
       num += select((floatV)(0.0f), w * p, in);
       den += select((floatV)(0.0f), w, in);
+#endif
     }
   }
   const float d = lanes_sum(den);
   /* No suction: a wall above the water (the gravity term below zero) pushes nothing. */
+#ifdef THAW_MULTIPHASE
+  col[COL_KR * stride + i] = d > 0.0f ? fmax(lanes_sum(num) / d, 0.0f) : 0.0f;
+#else
   col[COL_KR * stride + i] = d > 0.0f ? fmax(lanes_sum(num) / d, 0.0f) / (rest_density * rest_density) : 0.0f;
+#endif
 }
 
 /* The warm start (2017 §4.3): `share` of last step's accumulated κ of this solve as this iteration's KR
@@ -200,7 +260,11 @@ kernel void dfsph_warm(global const float* density, global const uchar* phase, g
     return;
   }
   const float k = share * (density_mode ? acc.x / (dt * dt) : acc.y / dt);
+#ifdef THAW_MULTIPHASE
+  col[COL_KR * stride + i] = k; /* π */
+#else
   col[COL_KR * stride + i] = k / density[i];
+#endif
   if (density_mode)
     acc.x = 0.0f;
   else
@@ -232,31 +296,68 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
   if (THAW_IS_STATIC(phase[i])) {
     /* A boundary particle does not move: it books the κ its fluid neighbours applied with it (their
      * pressure force from it; rigid ice takes the reaction through dfsph_pressure's state). */
+#ifdef THAW_MULTIPHASE
+    book_kappa(kappa, i, kri, dt, density_mode);
+#else
     book_kappa(kappa, i, kri * density[i], dt, density_mode);
+#endif
     return;
   }
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
   DFSPH_SOA(soa, stride)
+#ifdef THAW_MULTIPHASE
+  global const float* FM = col + COL_FM * stride;
+  const float rho0_i = pi.w / col[COL_VOL * stride + i];
+  /* A boundary neighbour's pressure: the light fluid (air) mirrors its own (Akinci et al. 2012, as Bender
+   * & Koschier's DFSPH does for every wall), since the wall's extrapolated pressure is the water's beside
+   * it and blows the air off the wall at the interface; the heavy fluid takes the wall's
+   * (dfsph_extrapolate). */
+  const int light_i = rho0_i < THAW_MP_SPLIT;
+#endif
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
       DFSPH_LANES(pr, j, je, H2)
+#ifdef THAW_MULTIPHASE
+      /* The pair's pressure weighted by the other's rest density (Hu & Adams 2006's inter-particle pressure):
+       * 2 p_ij = c_ij pi_i + (2 - c_ij) pi_j, c_ij = 2 rho0_j / (rho0_i + rho0_j); between fluids of one
+       * density pi_i + pi_j, and at air beside water almost 2 pi_air on both sides, so the water's pressure
+       * does not push the light air and the interface holds one pressure. Boundary neighbours: c = 1. */
+      const floatV vj = vloadV(0, col + COL_VOL * stride + j), fmj = vloadV(0, FM + j);
+#ifdef THAW_MP_SYMMETRIC /* solver.multiphase domaradzki_martyn: the pair's mean pressure */
+      const floatV cw = (floatV)(1.0f);
+#else
+      const floatV cw = select((floatV)(1.0f), 2.0f * vj / (rho0_i * fmj + vj), fmj > 0.0f);
+#endif
+      const floatV krj = vloadV(0, KR + j);
+      const floatV pj = light_i ? select((floatV)(kri), krj, fmj > 0.0f) : krj;
+      const floatV t = vj * (cw * kri + (2.0f - cw) * pj) * grad_shape(sqrt(r2) * inv_H);
+#else
       const floatV t = vloadV(0, M + j) * (kri + vloadV(0, KR + j)) * grad_shape(sqrt(r2) * inv_H);
+#endif
       ax += select((floatV)(0.0f), t * dx, in);
       ay += select((floatV)(0.0f), t * dy, in);
       az += select((floatV)(0.0f), t * dz, in);
     }
   }
-  const float3 dv = -dt * THAW_SIGMA(H) * inv_H * inv_H * (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
+#ifdef THAW_MULTIPHASE
+  const float mass_scale = col[COL_VOL * stride + i] / pi.w; /* 1 / rho0_i */
+  const float kb = kri;
+#else
+  const float mass_scale = 1.0f;
+  const float kb = kri * density[i];
+#endif
+  const float3 dv = -dt * mass_scale * THAW_SIGMA(H) * inv_H * inv_H *
+                    (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
   const float3 v = vel[i].xyz + dv;
   vel[i] = (float4)(v, 0.0f);
   soa[4 * stride + i] = v.x;
   soa[5 * stride + i] = v.y;
   soa[6 * stride + i] = v.z;
-  book_kappa(kappa, i, kri * density[i], dt, density_mode);
+  book_kappa(kappa, i, kb, dt, density_mode);
 }
 
 /* Per tile: the sum of the errors over fluid particles, and their count (deterministic, unlike atomics). */
@@ -304,6 +405,11 @@ kernel void dfsph_pressure(global const float* density, global const uchar* phas
   if (i >= n) return;
   const float rho = density[i];
   const float2 acc = kappa[i];
+#ifdef THAW_MULTIPHASE
+  /* The accumulators hold π dt² and π dt: p = Σπ, and p / ρ² as WCSPH's state has it. */
+  const float dp = dt > 0.0f ? (acc.y + acc.x / dt) / (dt * rho * rho) : 0.0f;
+#else
   const float dp = dt > 0.0f ? (acc.y + acc.x / dt) / (dt * rho) : 0.0f;
+#endif
   state[i] = (float4)(rho, dp, THAW_IS_STATIC(phase[i]) ? 1.0f : 0.0f, dp * rho * rho);
 }

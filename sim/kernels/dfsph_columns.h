@@ -7,4 +7,7 @@
 #define COL_AD 2
 #define COL_AV 3
 #define COL_ERR 4
+/* Multiphase builds (THAW_MULTIPHASE) only: each particle's rest volume V = m / rho0 of its material's row
+ * (a boundary particle's Psi / rho0 of the fluid it bounds: Akinci's volume). */
+#define COL_VOL 5
 #endif

@@ -59,6 +59,9 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
   const float dpi = state[i].y;
   const MaterialFlow mf = flow[material[i]];
   const float visc_i = mf.rest_density / state[i].x; /* the viscous pair term's rho0 / rho_i */
+#ifdef THAW_MULTIPHASE
+  const float mu_i = derived[i], rho0_i = mf.rest_density, inv_rho_i = 1.0f / state[i].x;
+#endif
   /* Body force per unit mass (fluid_params.h): gravity, or Boussinesq air's buoyancy. */
 #ifdef THAW_BUOYANCY
   const float2 h = enthalpy[i];
@@ -103,10 +106,28 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
        *   + k (m_j/rho_j) (rho0/rho_i) (v_ij . x_ij)/(r^2 + eps h^2) grad W,
        * grad W = grad_factor x_ij with grad_factor = sigma / H^2 grad_shape(q). */
       const floatV r = sqrt(r2);
+#ifdef THAW_MULTIPHASE
+      /* Fluids of several densities (DFSPH: the pressure is dfsph.cl's): the viscous pair force
+       * mu_ij V_i V_j (v_ij . x_ij)/(r^2 + eps h^2) grad W, equal and opposite whatever the two weigh,
+       * with mu_ij the harmonic mean of the two dynamic coefficients (Hu & Adams 2006: the interface
+       * takes the weaker fluid's shear, as a continuous stress would), or with
+       * THAW_VISC_ARITHMETIC_MEAN their average (Domaradzki & Martyn eq 5, selectable by name); a
+       * boundary neighbour's coefficient is kinematic (negative in KV) and taken at the fluid's density. */
+      const floatV kv = vloadV(0, KV + j);
+#ifdef THAW_VISC_ARITHMETIC_MEAN
+      const floatV mean = 0.5f * (mu_i + kv);
+#else
+      const floatV mean = 2.0f * mu_i * kv / fmax(mu_i + kv, 1e-30f);
+#endif
+      const floatV mu = select(mean, -kv * rho0_i, kv < 0.0f);
+      const floatV s = grad_shape(r * inv_H) * (mu * vloadV(0, MP + j) * (inv_rho_i * vd) / (r2 + eps2)) +
+                       rep * vloadV(0, RB + j) * repulsion(r, vd, rep_r0, rep_d);
+#else
       const floatV s =
           grad_shape(r * inv_H) *
               (vloadV(0, KV + j) * (visc_i * vd) / (r2 + eps2) - (vloadV(0, M + j) * dpi + vloadV(0, MP + j))) +
           rep * vloadV(0, RB + j) * repulsion(r, vd, rep_r0, rep_d);
+#endif
       /* Masked after the products: lanes past the row may hold any particle's (even non-finite) data. */
       ax += select((floatV)(0.0f), s * dx, in);
       ay += select((floatV)(0.0f), s * dy, in);

@@ -39,7 +39,12 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
                          global const uchar* phase, global const uint* body, global const Body* bodies,
                          global const uint* cell_start, const Grid g, const float H, const float eps2,
                          const float visc_boundary, const float rho0, const Contact contact,
-                         global float4* force, const uint n) {
+                         global float4* force, const uint n
+#ifdef THAW_MULTIPHASE
+                         ,
+                         global const uchar* material, global const MaterialFlow* flow
+#endif
+) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   const uint b = body[i];
@@ -65,7 +70,16 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
       const float4 sj = state[j];
       const float mj = pos[j].w;
       const float vd = dot(vi.xyz - vel[j].xyz, x);
+#ifdef THAW_MULTIPHASE
+      /* Fluids of several densities (dfsph.cl, forces.cl): pressure -V_b V_j (p_b + p_j) grad W with rest
+       * volumes V_b = Psi_b / rho0, V_j = m_j / rho0_j, and the boundary's viscosity at the fluid's own
+       * density; the sum is multiplied by m_b = Psi_b below. */
+      const float rho0_j = flow[material[j]].rest_density;
+      const float s = visc_boundary * mj * (rho0_j / (rho_i * sj.x)) * vd / (r2 + eps2) -
+                      (mj / (rho0_j * rho0)) * (si.w + sj.w);
+#else
       const float s = visc_boundary * mj * (rho0 / (rho_i * sj.x)) * vd / (r2 + eps2) - mj * (dpi + sj.y);
+#endif
       f_fluid += s * KERNEL_GRAD(sqrt(r2), H) * x;
     } else if (r2 < d2 && (pj == THAW_PHASE_SOLID || (pj == THAW_PHASE_ICE && body[j] != b))) {
       const float r = sqrt(r2);

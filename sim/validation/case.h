@@ -55,6 +55,7 @@ ValidationCase floating_case();
 ValidationCase cavity_case();
 ValidationCase jet_case();
 ValidationCase air_sphere_case();
+ValidationCase air_water_case();
 
 // Churchill's correlation for natural convection around a sphere: Nu(Ra, Pr) (sim/validation/air_sphere.cpp).
 double churchill_sphere_nusselt(double rayleigh, double prandtl);

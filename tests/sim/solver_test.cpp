@@ -435,8 +435,8 @@ TEST_F(SolverTest, LoneDropsRestOnAWallWithoutTheClamp) {
 
 // Flow properties are a table per material (sim/fluid_stage.h): a boundary material carries the rest
 // density of the fluid it bounds; the viscous time-step limit takes the most viscous fluid; two rest
-// densities are refused, naming the block, until the air model lands.
-TEST_F(SolverTest, FlowPropertiesArePerMaterialAndTwoRestDensitiesAreRefused) {
+// densities need DFSPH's multiphase form, and WCSPH refuses them by name.
+TEST_F(SolverTest, FlowPropertiesArePerMaterialAndTwoRestDensitiesNeedDfsph) {
   Scene scene =
       dam_break({"materials.syrup={\"kind\": \"fluid\", \"density\": 1000, \"viscosity\": 0.5, "
                  "\"conductivity\": 0.5, \"specific_heat\": 3000}"});
@@ -460,14 +460,19 @@ TEST_F(SolverTest, FlowPropertiesArePerMaterialAndTwoRestDensitiesAreRefused) {
   Solver both(cl(), scene, initial_state(scene));
   both.step();
 
+  // Two rest densities: DFSPH's multiphase form only (sim/kernels/dfsph.cl); WCSPH is refused by name.
   scene.materials[std::size_t(syrup)].density = 1100;
+  scene.solver.pressure = PressureSolver::Wcsph;
   try {
     Solver refused(cl(), scene, initial_state(scene));
-    FAIL() << "two rest densities were accepted";
+    FAIL() << "two rest densities were accepted by wcsph";
   } catch (const SceneError& e) {
-    EXPECT_EQ(e.path(), "fluids[1].material");
-    EXPECT_NE(std::string(e.what()).find("two rest densities"), std::string::npos) << e.what();
+    EXPECT_EQ(e.path(), "solver.pressure");
+    EXPECT_NE(std::string(e.what()).find("dfsph"), std::string::npos) << e.what();
   }
+  scene.solver.pressure = PressureSolver::Dfsph;
+  Solver multiphase(cl(), scene, initial_state(scene));
+  multiphase.step();
 }
 
 // Water that runs out through an open side is removed and booked, not held at the face: the fluid's mass
