@@ -12,7 +12,8 @@
 namespace thaw {
 
 namespace {
-constexpr int kColumns = 6;  // FM, KR, AD, AV, ERR, VOL (sim/kernels/dfsph_columns.h)
+// FM, KR, AD, AV, ERR (sim/kernels/dfsph_columns.h), and VOL in multiphase builds only.
+constexpr int kColumns = 5;
 // The share of last step's kappa a warm start applies. All of it ratchets: the solves only add (they
 // correct compression, never expansion), so a warm start that overshoots is never taken back, and the
 // hydrostatic tank's kinetic energy grew tenfold every 10 ms until it blew up. Half, as SPlisHSPlasH's
@@ -72,9 +73,10 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   density_tolerance_ = scene.solver.density_tolerance;
   divergence_tolerance_ = scene.solver.divergence_tolerance;
   max_iterations_ = scene.solver.max_pressure_iterations;
-  col_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::size_t(layout.stride) * kColumns * 4);
+  const int columns = kColumns + (scene.multiphase() ? 1 : 0);
+  col_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::size_t(layout.stride) * columns * 4);
   // Lanes read up to 15 floats past the last particle: keep the padding finite.
-  cl.queue().enqueueFillBuffer(col_, 0.0f, 0, std::size_t(layout.stride) * kColumns * 4);
+  cl.queue().enqueueFillBuffer(col_, 0.0f, 0, std::size_t(layout.stride) * columns * 4);
   sums_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(layout.max_tiles, 1) * 8);
 }
 
