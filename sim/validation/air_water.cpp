@@ -1,6 +1,6 @@
-// Air over water at rest (docs/VALIDATION-RESULTS.md): a closed tank, water of depth H under a layer of
-// air, both at the same temperature, at the real density ratio (1.2 : 1000 by default). Reference: the
-// interface stays flat and both fluids still; the mean speed of each below 1e-3 sqrt(g H) (issue 18's
+// Air over water at rest (docs/VALIDATION-RESULTS.md): a tank open at the top, water of depth H under a
+// layer of air, both at the same temperature, at the real density ratio (1.2 : 1000 by default). Reference:
+// the interface stays flat and both fluids still; the mean speed of each below 1e-3 sqrt(g H) (issue 18's
 // gate), the water level of the tank's quarters within half a spacing, no particle lost. After a damped
 // settle as in the hydrostatic case, the speeds are averaged over an undamped window.
 #include <algorithm>
@@ -54,7 +54,11 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
       {"domain",
        {{"min", {0.0, 0.0, 0.0}},
         {"max", {W, W, top}},
-        {"walls", {"-x", "+x", "-y", "+y", "-z", "+z"}},
+        // Open at the top, to the room: in a closed box the two incompressible fluids must fill it
+        // exactly, and what the water's 0.1 % tolerance leaves over went to the air, which the solve
+        // found uniformly compressed by 0.4 % and could not relieve (100 sweeps, unconverged): at res 30
+        // it blew up at step 24. A real closed box's air would give way; ours has no compressibility.
+        {"walls", {"-x", "+x", "-y", "+y", "-z"}},
         {"wall_material", "wall"}}},
       {"gravity", {0.0, 0.0, -g}},
       {"spacing", dx},
