@@ -44,22 +44,30 @@ std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const S
       // 2 m/s against the far wall of a closed box (0.5 % density tolerance) 12 particles a step got
       // past the walls' pressure to the domain's face (clamped, 9,238 in 768 steps); with the push, none.
       f.push = scene.air_dryer_count() > 0 ? 1.0f : 0.0f;
+      f.artificial_buoyancy = static_cast<float>(air.artificial_buoyancy);
+      f.max_temperature = static_cast<float>(air.max_temperature);
+      f.inv_specific_heat = static_cast<float>(1.0 / m.specific_heat);
       if (air.buoyancy == Buoyancy::Boussinesq) {
         f.expansion = static_cast<float>(air.expansion);
         f.reference_temperature = static_cast<float>(air.reference_temperature);
-        f.inv_specific_heat = static_cast<float>(1.0 / m.specific_heat);
         // Without heat every air particle stays at its starting temperature: its buoyancy is a constant.
         if (!with_heat)
           f.gravity = static_cast<float>(-air.expansion * (air.temperature - air.reference_temperature));
       }
+      // Eq 8 at the starting temperature, as a share of gravity (against it), likewise.
+      if (!with_heat && air.artificial_buoyancy > 0 && scene.gravity.norm() > 0)
+        f.gravity -=
+            static_cast<float>(air.artificial_buoyancy /
+                               std::max(air.max_temperature - air.temperature, 1.0) / scene.gravity.norm());
     }
   }
   return table;
 }
 
 bool buoyancy_reads_temperature(const Scene& scene, bool with_heat) {
-  return with_heat && scene.has_air() && scene.air.buoyancy == Buoyancy::Boussinesq &&
-         scene.air.expansion > 0;
+  return with_heat && scene.has_air() &&
+         ((scene.air.buoyancy == Buoyancy::Boussinesq && scene.air.expansion > 0) ||
+          scene.air.artificial_buoyancy > 0);
 }
 
 FluidStage::FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,

@@ -311,6 +311,8 @@ AirFill air_fill_from_json(const Json& a, const Scene& s, const Json& materials)
   air.expansion =
       a.contains("expansion") ? a["expansion"].get<double>() : 1.0 / (air.reference_temperature + 273.15);
   air.face_time = a["face_exchange_time"].get<double>();
+  air.artificial_buoyancy = a["artificial_buoyancy"].get<double>();
+  air.max_temperature = a["max_temperature"].get<double>();
   air.face_depth = a["face_exchange_depth"].get<double>();
   if (air.face_depth == 0) air.face_depth = s.solver.support_ratio * s.spacing;
   return air;

@@ -97,6 +97,10 @@ struct AirFill {
   // heat a closed room without end; booked as ambient exchange. face_time 0: off.
   double face_time = 0.0;   // [s]
   double face_depth = 0.0;  // [m]; the scene loader puts one kernel support for 0
+  // Domaradzki & Martyn eq 8: an upward acceleration sigma / (T_max - T) on every air particle, on top of
+  // its buoyancy; 0: off (the default: Boussinesq is the physical force, eq 8 is for comparison).
+  double artificial_buoyancy = 0.0;  // sigma [K m/s^2]
+  double max_temperature = 100.0;    // T_max [°C]
 };
 
 struct FluidBlock {

@@ -436,6 +436,20 @@ const Field& scene_schema() {
                       .at_least(0)
                       .at_most(1)
                       .optional(),
+                  number("artificial_buoyancy",
+                         "sigma of Domaradzki & Martyn's artificial force (eq 8): every air particle also "
+                         "feels sigma / (max_temperature - T) upward, per unit mass (T_max - T no less than "
+                         "1 K). 0: off, the default; the paper added it where its eq 7 rose too slowly, for "
+                         "comparison with Boussinesq buoyancy")
+                      .in("K m/s^2")
+                      .def(0.0)
+                      .at_least(0)
+                      .at_most(1e6),
+                  number("max_temperature", "T_max of eq 8, the highest temperature the scene allows")
+                      .in("°C")
+                      .def(100.0)
+                      .above(-273.15)
+                      .at_most(3000),
                   number("face_exchange_time",
                          "Air within face_exchange_depth of a side of the domain that is not periodic "
                          "relaxes toward heat.ambient_temperature with this time constant, as if the room "

@@ -24,6 +24,10 @@ typedef struct {
   float reference_temperature; /* T0 [°C] */
   float inv_specific_heat;     /* 1 / c [kg K/J] */
   float push;                  /* 1: the walls' short-range push acts on it (forces.cl); 0: not (air) */
+  /* Domaradzki & Martyn's artificial buoyancy (eq 8), air.artificial_buoyancy: an upward acceleration
+   * sigma / (T_max - T) [m/s^2], with T_max - T no less than 1 K; sigma 0: off. */
+  float artificial_buoyancy; /* sigma [K m/s^2] */
+  float max_temperature;     /* T_max [°C] */
 } MaterialFlow;
 
 typedef struct {
@@ -48,7 +52,7 @@ typedef struct {
 } ForcesParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(MaterialFlow) == 36, "MaterialFlow must match its OpenCL layout");
+static_assert(sizeof(MaterialFlow) == 44, "MaterialFlow must match its OpenCL layout");
 static_assert(sizeof(DensityParams) == 32, "DensityParams must match its OpenCL layout");
 static_assert(sizeof(ForcesParams) == 48, "ForcesParams must match its OpenCL layout");
 }  // namespace thaw::fluid

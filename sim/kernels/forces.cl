@@ -65,9 +65,16 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
   /* Body force per unit mass (fluid_params.h): gravity, or Boussinesq air's buoyancy. */
 #ifdef THAW_BUOYANCY
   const float2 h = enthalpy[i];
-  const float body = mf.gravity - mf.expansion * ((h.x + h.y) * mf.inv_specific_heat - mf.reference_temperature);
+  const float T = (h.x + h.y) * mf.inv_specific_heat;
+  const float body = mf.gravity - mf.expansion * (T - mf.reference_temperature);
+  /* Domaradzki & Martyn eq 8: F_b = sigma / (T_max - T_i) v_up, per unit mass here, v_up against gravity
+   * (+z without it); T_max - T held at 1 K or more, where the paper's form has its pole. */
+  const float glen = length(gravity.xyz);
+  const float3 up = glen > 0.0f ? -gravity.xyz / glen : (float3)(0.0f, 0.0f, 1.0f);
+  const float3 artificial = mf.artificial_buoyancy / fmax(mf.max_temperature - T, 1.0f) * up;
 #else
   const float body = mf.gravity;
+  const float3 artificial = (float3)(0.0f);
 #endif
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
@@ -135,5 +142,5 @@ kernel void forces(global const float4* pos, global const float4* vel, global co
     }
   }
   const float3 a = scale * (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
-  accel[i] = (float4)(a + body * gravity.xyz, 0.0f);
+  accel[i] = (float4)(a + body * gravity.xyz + artificial, 0.0f);
 }

@@ -214,6 +214,34 @@ TEST_F(AirTest, AirBesideWaterOfAnotherDensityRunsWithDfsphOnly) {
   }
 }
 
+// Domaradzki & Martyn's artificial buoyancy (eq 8) is off by default; set, every air particle at T gains
+// sigma / (T_max - T) upward per unit mass. Uniform air at 30 °C, no Boussinesq force (T = T0), no solid:
+// after 20 steps the air's mean vertical speed is that acceleration times the time.
+TEST_F(AirTest, ArtificialBuoyancyIsOffByDefaultAndGivesSigmaOverTmaxLessT) {
+  Json doc = air_box();
+  doc["solids"] = Json::array();
+  auto mean_vz = [&](const Json& d, double* t) {
+    const Scene scene = scene_from_json(d);
+    Solver s(cl(), scene, initial_state(scene));
+    for (int k = 0; k < 20; ++k) s.step();
+    *t = s.time();
+    const HostParticles p = s.particles();
+    double sum = 0, n = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.phase[i] == kAir) sum += p.velocity[i][2], n += 1;
+    return sum / n;
+  };
+  double t = 0;
+  const double off = mean_vz(doc, &t);
+  doc["air"]["artificial_buoyancy"] = 0.4;
+  doc["air"]["max_temperature"] = 70.0;
+  const double a = 0.4 / (70.0 - 30.0);
+  EXPECT_LT(std::abs(off), 0.05 * a * t) << "off by default";
+  const double on = mean_vz(doc, &t);
+  EXPECT_NEAR(on - off, a * t, 0.02 * a * t);
+  std::printf("[ info ] off %.4g, on %.4g, a t %.4g m/s\n", off, on, a * t);
+}
+
 // Water filling a box periodic in y and z, walled in x, moving uniformly along y and z in zero gravity:
 // particles leave through one side and come back through the other, nothing is clamped, the density
 // stays uniform across the seams (a wrong image would show there first) and the velocity stays as it was.
