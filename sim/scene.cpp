@@ -257,6 +257,7 @@ HeatSettings heat_settings_from_json(const Json& doc) {
   HeatSettings h;
   h.enabled = doc["heat"]["enabled"].get<bool>();
   h.time_scale = doc["heat"]["time_scale"].get<double>();
+  h.max_substeps = doc["heat"]["max_substeps"].get<int>();
   h.exposed_area = choice_of<ExposedArea>(doc["heat"]["exposed_area"], {ExposedArea::Iwasaki2010});
   h.ambient_temperature = doc["ambient"]["temperature"].get<double>();
   h.ambient_coefficient = doc["ambient"]["heat_transfer_coefficient"].get<double>();
@@ -491,6 +492,10 @@ Scene convert_and_check(Json doc, const std::string& folder) {
 
   for (std::size_t i = 0; i < doc["lamps"].size(); ++i)
     s.lamps.push_back(lamp_from_json(doc["lamps"][i], join_path("lamps", i)));
+  // A lamp's photons are traced once a flow step and absorbed by the heat pass that follows: sub-steps
+  // would absorb them again.
+  if (s.heat.max_substeps > 1 && !s.lamps.empty())
+    throw SceneError("heat.max_substeps", "lamps trace their photons once a step: with lamps it must be 1");
   for (std::size_t i = 0; i < doc["dryers"].size(); ++i) {
     s.dryers.push_back(dryer_from_json(doc["dryers"][i], join_path("dryers", i)));
     check_dryer(s.dryers.back(), s, join_path("dryers", i));

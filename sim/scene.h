@@ -176,6 +176,9 @@ struct Emitter {
 struct HeatSettings {
   bool enabled = true;
   double time_scale = 1.0;  // heat runs this much faster than the flow
+  // Heat steps a flow step may hold: where conduction (times time_scale) limits the step, the heat pass
+  // runs up to this many sub-steps at fixed positions and the flow takes the longer step.
+  int max_substeps = 1;
   ExposedArea exposed_area = ExposedArea::Iwasaki2010;
   double ambient_temperature = 20.0;  // [°C]
   double ambient_coefficient = 10.0;  // h [W/m^2/K]

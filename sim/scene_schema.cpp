@@ -302,6 +302,16 @@ const Field& scene_schema() {
                       .above(0)
                       .at_most(1e6)
                       .client_settable(),
+                  integer(
+                      "max_substeps",
+                      "Heat steps one flow step may hold. Where conduction (times time_scale) sets the time "
+                      "step, as in air with a raised time_scale, the heat pass runs up to this many "
+                      "sub-steps with the particles where they are, and the flow takes one step as long "
+                      "as all of them (operator splitting). 1: heat and flow share every step. Lamps "
+                      "need 1 (their photons are traced once a step)")
+                      .def(1)
+                      .at_least(1)
+                      .at_most(64),
                   choice("exposed_area", {"iwasaki2010"},
                          "Model of each particle's surface exposed to air: iwasaki2010 = (6 - n_i) / 6 of a "
                          "voxel's six faces, n_i the particles within 1.2 spacings (Iwasaki et al. 2010 sec. "

@@ -554,7 +554,8 @@ double Solver::choose_time_step() {
   // a plane Poiseuille flow up in 160 steps at 0.125 h^2 / nu; 0.05 h^2 / nu ran).
   const double hv = std::min(double(h), scene_.spacing);
   if (k_.kinematic_viscosity > 0) dt = std::min(dt, s.viscous_number * hv * hv / k_.kinematic_viscosity);
-  const double dt_heat = heat_time_step();
+  // Conduction's limit, or as many of it as heat.max_substeps lets one flow step hold (compute_heat).
+  const double dt_heat = heat_time_step() * scene_.heat.max_substeps;
   dt = std::min(dt, dt_heat);
   dt = static_cast<float>(dt);  // the kernels see a float: keep host time consistent with them
   if (dt < s.min_dt) {
@@ -575,7 +576,16 @@ NeighbourView Solver::neighbours() const { return grid_->view(); }
 
 void Solver::compute_heat(double dt) {
   if (!heat_) return;
-  if (heat_->run(dt, neighbours(), budget_, steps_, time_, rigid_ != nullptr)) rigid_->note_phase_change();
+  // Sub-steps (heat.max_substeps): equal parts of the flow step, each within conduction's limit, with the
+  // particles where they are; the books add up over them.
+  const double limit = heat_->max_dt();
+  const int parts =
+      dt > limit ? std::min(scene_.heat.max_substeps, static_cast<int>(std::ceil(dt / limit - 1e-9))) : 1;
+  bool changed = false;
+  for (int k = 0; k < parts; ++k)
+    changed |=
+        heat_->run(dt / parts, neighbours(), budget_, steps_, time_ + k * (dt / parts), rigid_ != nullptr);
+  if (changed) rigid_->note_phase_change();
 }
 
 void Solver::label_ice() {
