@@ -909,7 +909,9 @@ double Scene::rest_density_split() const {
   const auto rest = fluid_rest_densities();
   if (rest.empty()) return 0;
   const auto [lo, hi] = std::minmax_element(rest.begin(), rest.end());
-  return *lo == *hi ? 0.5 * *lo : std::sqrt(*lo * *hi);
+  // Only a gas-like contrast makes a light fluid (its walls mirror its own pressure, dfsph.cl): two
+  // liquids (water and a syrup 10 % denser) both take the walls' extrapolated pressure.
+  return *hi >= 5.0 * *lo ? std::sqrt(*lo * *hi) : 0.5 * *lo;
 }
 
 Scene scene_from_json(Json doc, const std::vector<std::string>& overrides, const std::string& folder) {

@@ -249,8 +249,8 @@ struct Scene {
   // Fluids of more than one rest density can meet: air beside water, or beside the water ice melts into.
   // The fluid passes are then built with the number-density multiphase form (sim/kernels/dfsph.cl).
   bool multiphase() const;
-  // Between the light fluids' rest densities and the heavy ones' (their geometric mean): the multiphase
-  // passes tell air from water by it.
+  // Between the light fluids' rest densities and the heavy ones' (their geometric mean) where they differ
+  // five-fold or more, else below them all: the multiphase passes tell air from water by it.
   double rest_density_split() const;
   // The rest densities of every fluid the scene has or makes (blocks, emitters, melted ice, air).
   std::vector<double> fluid_rest_densities() const;
