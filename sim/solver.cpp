@@ -751,7 +751,11 @@ bool Solver::set_emitter(std::size_t index, const Emitter& e) {
 std::vector<std::string> Solver::stages() const {
   std::vector<std::string> out = {"grid"};
   if (fluid_) out.insert(out.end(), {"density", "forces"});
-  if (dfsph_) out.push_back("pressure (dfsph)");
+  // A newcomer sees which form holds air beside water (the same solve, other passes).
+  if (dfsph_)
+    out.push_back(scene_.multiphase()
+                      ? std::string("pressure (dfsph, multiphase ") + name(scene_.solver.multiphase) + ")"
+                      : std::string("pressure (dfsph)"));
   if (rigid_) out.push_back("rigid ice");
   out.push_back("time step");
   if (heat_ && heat_->tracing_photons()) out.push_back("photons");

@@ -173,11 +173,10 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
   k *= THAW_OMEGA; /* relaxed Jacobi */
 #ifdef THAW_MULTIPHASE
   col[COL_KR * stride + i] = k; /* the pressure π */
-  col[COL_ERR * stride + i] = fabs(err);
 #else
   col[COL_KR * stride + i] = k / rho;
-  col[COL_ERR * stride + i] = err;
 #endif
+  col[COL_ERR * stride + i] = err; /* ≥ 0: both solves correct compression only */
 }
 
 /* A boundary particle's KR from the fluid around it (Adami et al. 2012, eq 27, the wall's acceleration
@@ -310,10 +309,11 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
 #ifdef THAW_MULTIPHASE
   global const float* FM = col + COL_FM * stride;
   const float rho0_i = pi.w / col[COL_VOL * stride + i];
-  /* A boundary neighbour's pressure: the light fluid (air) mirrors its own (Akinci et al. 2012, as Bender
-   * & Koschier's DFSPH does for every wall), since the wall's extrapolated pressure is the water's beside
-   * it and blows the air off the wall at the interface; the heavy fluid takes the wall's
-   * (dfsph_extrapolate). */
+  /* A boundary neighbour's pressure: the light fluid (air) takes its own for the wall's (pressure
+   * mirroring, p_b = p_i, the full load; not boundary_pressure akinci2012's one-sided half), since the
+   * wall's extrapolated pressure is the water's beside it and blows the air off the wall at the
+   * interface; the heavy fluid takes the wall's (dfsph_extrapolate). density.cl counts the mirror twice
+   * in the light fluid's alpha. */
   const int light_i = rho0_i < THAW_MP_SPLIT;
 #endif
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);

@@ -205,6 +205,11 @@ TEST_F(AirTest, AirBesideWaterOfAnotherDensityRunsWithDfsphOnly) {
     const Scene two = scene_from_json(doc);
     ASSERT_TRUE(two.multiphase());
     Solver s(cl(), two, initial_state(two));
+    const std::vector<std::string> stages = s.stages();
+    EXPECT_NE(
+        std::find(stages.begin(), stages.end(), std::string("pressure (dfsph, multiphase ") + model + ")"),
+        stages.end())
+        << "the stage list names the model";
     const double air0 = s.particles().mass(Phase::Air);
     for (int k = 0; k < 20; ++k) s.step();
     const HostParticles p = s.particles();
