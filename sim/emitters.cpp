@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "sim/error.h"
+#include "sim/solver.h"
 #include "sim/thermal.h"
 
 namespace thaw {
@@ -40,8 +41,41 @@ double EmitterStage::particles_per_second(const Dryer& d, double spacing) {
   return d.area() * d.speed / (spacing * spacing * spacing);
 }
 
+EmitterStage::EmitterStage(const Scene& scene)
+    : scene_(scene),
+      pending_(scene.emitters.size() + scene.dryers.size(), 0.0),
+      owed_(scene.dryers.size(), 0.0),
+      room_sites_(admits_room_air(scene) ? room_air_sites(scene) : std::vector<Eigen::Vector3d>{}) {}
+
 bool EmitterStage::needed(const Scene& scene) {
-  return !scene.emitters.empty() || scene.air_dryer_count() > 0;
+  return !scene.emitters.empty() || scene.air_dryer_count() > 0 || admits_room_air(scene);
+}
+
+void EmitterStage::admit_room_air(const std::vector<std::uint32_t>& empty,
+                                  const std::vector<Eigen::Vector3f>& velocity, HostParticles& out,
+                                  std::uint32_t& next_id) {
+  if (empty.empty()) return;
+  const double dx = scene_.spacing;
+  const int air = scene_.air.material;
+  const float mass =
+      static_cast<float>(scene_.materials[static_cast<std::size_t>(air)].density * dx * dx * dx);
+  const double h = enthalpy_at(scene_, air, scene_.heat.ambient_temperature);
+  const float h_hi = static_cast<float>(h), h_lo = static_cast<float>(h - double(h_hi));
+  for (std::size_t k = 0; k < empty.size(); ++k) {
+    const Eigen::Vector3d& x = room_sites_.at(empty[k]);
+    const Eigen::Vector3f& v = velocity.at(k);
+    out.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
+    out.velocity.push_back({v.x(), v.y(), v.z(), 0.f});
+    out.density.push_back(0.f);
+    out.phase.push_back(static_cast<std::uint8_t>(Phase::Air));
+    out.material.push_back(static_cast<std::uint8_t>(air));
+    out.id.push_back(next_id++);
+    out.enthalpy.push_back({h_hi, h_lo});
+    out.anchored.push_back(0);
+    books_.particles += 1;
+    books_.mass += double(mass);
+    books_.momentum += double(mass) * v.cast<double>();
+  }
 }
 
 std::size_t EmitterStage::lay(const Nozzle& z, double open_for, double& pending, HostParticles& out,

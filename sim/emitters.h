@@ -22,6 +22,15 @@
 // the pipe takes the room's air in as long as the dryer owes particles: blown and not yet taken in. So a
 // dryer draws room air in as a real one does, and over time takes in as many particles as it blows: a
 // closed room keeps its air (tests/sim/air_test.cpp).
+//
+// Open sides (domain.open) of a scene with air are the room beyond the domain: air that leaves through one
+// is removed (sim/kernels/grid.cl, booked as outflow), and the room's air comes back in. The sites are the
+// air's lattice points within one spacing of an open side (room_air_sites); at the end of each step a
+// site that no particle is near and where air is not leaving (grid.cl, empty_sites) gets a particle of
+// air at the ambient temperature (ambient.temperature) that moves as the air around the site does,
+// booked here as inflow. So a plume rises out of an open top while still air beside it stays (no site
+// there is empty), and the particle count stays bounded where a closed side would hold every particle
+// that reaches it (clamped and counted).
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
@@ -58,14 +67,20 @@ class EmitterStage {
     return 0.5 * d.nozzle_diameter + 0.5 * spacing;
   }
   static constexpr double mouth_depth = 1.5, body_depth = 3.0;
+  // A room-air site takes air when no particle is within room_air_gap spacings of it and the air there is
+  // not leaving (grid.cl, empty_sites): in a lattice moving inward, when the last layer has gone a spacing.
+  static constexpr double room_air_gap = 0.95;
 
   // Emitters first, then the air dryers, in the scene's order.
-  explicit EmitterStage(const Scene& scene)
-      : scene_(scene),
-        pending_(scene.emitters.size() + scene.dryers.size(), 0.0),
-        owed_(scene.dryers.size(), 0.0) {}
-  // Whether the scene has anything this stage pours: an emitter or an air dryer.
+  explicit EmitterStage(const Scene& scene);
+  // Whether the scene has anything this stage pours: an emitter, an air dryer, or air beside an open side.
   static bool needed(const Scene& scene);
+  // Whether the room's air comes in through open sides: air, an open side, and flow.
+  static bool admits_room_air(const Scene& scene) {
+    return scene.solver.flow && scene.has_air() && scene.open_faces != 0;
+  }
+  // The room-air sites (room_air_sites(scene)), fixed for the run.
+  const std::vector<Eigen::Vector3d>& room_sites() const { return room_sites_; }
 
   // The particles the emitters pour between t and t + dt (each emitter open within [start, stop)) and the
   // air dryers blow (each while on), with ids from next_id on (advanced), in the order of the emitters
@@ -73,6 +88,10 @@ class EmitterStage {
   // books their particles, mass and momentum (the solver books their enthalpy in the energy budget).
   // Empty when nothing is due.
   HostParticles emit(double t, double dt, std::uint32_t& next_id);
+  // Air at the ambient temperature on the room-air sites `empty` (indices into room_sites(), in increasing
+  // order), each moving at its `velocity`, appended to `out` with ids from next_id on; books them.
+  void admit_room_air(const std::vector<std::uint32_t>& empty, const std::vector<Eigen::Vector3f>& velocity,
+                      HostParticles& out, std::uint32_t& next_id);
 
   const InflowBooks& books() const { return books_; }
   // Per dryer, the particles it has blown and not yet taken in (NeighbourGrid::build takes them in).
@@ -101,6 +120,7 @@ class EmitterStage {
 
   const Scene& scene_;  // the solver's, whose emitters a client may change between steps
   std::vector<double> pending_, owed_;
+  std::vector<Eigen::Vector3d> room_sites_;
   InflowBooks books_;
 };
 

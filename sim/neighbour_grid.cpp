@@ -27,7 +27,7 @@ ClGrid cl_grid(const GridInfo& gi) {
 NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, int reach,
                              const std::string& build_options, const ParticleLayout& layout,
                              const Eigen::Vector3f& lo, const Eigen::Vector3f& hi)
-    : cl_(cl), scene_(scene), layout_(layout) {
+    : cl_(cl), scene_(scene), layout_(layout), support_(support) {
   // A few ulps above H / reach, so float rounding in grid_cell() never puts a neighbour just inside the
   // support more than `reach` cells away.
   info_.cell = support / float(reach) * (1.0f + 8.0f * std::numeric_limits<float>::epsilon());
@@ -69,11 +69,13 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   sort_passes_ = static_cast<std::uint32_t>((bits + 10) / 11);
   radix_bits_ = static_cast<std::uint32_t>((bits + int(sort_passes_) - 1) / int(sort_passes_));
 
-  const auto program =
-      cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "grid.cl"},
-               build_options + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_) +
-                   " -DTHAW_SCAN_CHUNK=" + std::to_string(kScanChunk) + (intake_ ? " -DTHAW_INTAKE" : ""));
+  const bool room_air = EmitterStage::admits_room_air(scene);
+  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "grid.cl"},
+                                build_options + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_) +
+                                    " -DTHAW_SCAN_CHUNK=" + std::to_string(kScanChunk) +
+                                    (intake_ ? " -DTHAW_INTAKE" : "") + (room_air ? " -DTHAW_ROOM_AIR" : ""));
   k_cell_keys_ = cl::Kernel(program, "cell_keys");
+  if (room_air) k_empty_sites_ = cl::Kernel(program, "empty_sites");
   if (intake_) {
     k_intake_flags_ = cl::Kernel(program, "intake_flags");
     k_set_flags_ = cl::Kernel(program, "set_flags");
@@ -214,6 +216,56 @@ std::size_t NeighbourGrid::build(ParticleStore& store, const CoreFields& f, cons
   cl_uint kept = 0;
   q.enqueueReadBuffer(cell_start_, CL_TRUE, std::size_t(ncells_) * 4, 4, &kept);
   return kept;
+}
+
+void NeighbourGrid::set_room_sites(const std::vector<Eigen::Vector3d>& sites) {
+  room_sites_ = static_cast<cl_uint>(sites.size());
+  if (sites.empty()) return;
+  if (!k_empty_sites_()) throw Error("room-air sites given to a grid built without -DTHAW_ROOM_AIR");
+  // Each site, and the outward normal of the nearest open side (grid.cl).
+  const auto& d = scene_.domain;
+  std::vector<cl_float4> x(sites.size()), out(sites.size());
+  for (std::size_t s = 0; s < sites.size(); ++s) {
+    x[s] = {{float(sites[s].x()), float(sites[s].y()), float(sites[s].z()), 0.f}};
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a)
+      for (const bool upper : {false, true}) {
+        if (!(scene_.open_faces & (1u << (2 * a + (upper ? 1 : 0))))) continue;
+        const double dist = upper ? d.max[a] - sites[s][a] : sites[s][a] - d.min[a];
+        if (dist >= nearest) continue;
+        nearest = dist;
+        out[s] = {{0.f, 0.f, 0.f, 0.f}};
+        out[s].s[a] = upper ? 1.f : -1.f;
+      }
+  }
+  auto& ctx = cl_.context();
+  sites_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, x.size() * 16, x.data());
+  site_out_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, out.size() * 16, out.data());
+  empty_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, x.size() * 4);
+  site_vel_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, x.size() * 16);
+  if (!listed_()) listed_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, 4);
+}
+
+NeighbourGrid::EmptySites NeighbourGrid::empty_sites(ParticleStore& store, const CoreFields& f, double gap) {
+  EmptySites out;
+  if (!room_sites_ || layout_.n == 0) return out;
+  auto& q = cl_.queue();
+  q.enqueueFillBuffer(listed_, cl_uint(0), 0, 4);
+  set_args(k_empty_sites_, store[f.position], store[f.velocity], store[f.phase], cell_start_, cl_grid(info_),
+           sites_, site_out_, room_sites_, static_cast<cl_float>(gap * gap), static_cast<cl_float>(support_),
+           listed_, empty_, site_vel_);
+  launch(q, k_empty_sites_, room_sites_);
+  cl_uint listed = 0;
+  q.enqueueReadBuffer(listed_, CL_TRUE, 0, 4, &listed);
+  if (listed == 0) return out;
+  out.site.resize(listed);
+  q.enqueueReadBuffer(empty_, CL_TRUE, 0, std::size_t(listed) * 4, out.site.data());
+  // The slots' order varies from run to run; the particles laid must not.
+  std::sort(out.site.begin(), out.site.end());
+  std::vector<cl_float4> v(room_sites_);
+  q.enqueueReadBuffer(site_vel_, CL_TRUE, 0, v.size() * 16, v.data());
+  for (const std::uint32_t s : out.site) out.velocity.emplace_back(v[s].s[0], v[s].s[1], v[s].s[2]);
+  return out;
 }
 
 void NeighbourGrid::drive_pipes(ParticleStore& store, const CoreFields& f) {

@@ -50,6 +50,17 @@ class NeighbourGrid {
   // dryers as the last build() saw them. Nothing without blowing air dryers.
   void drive_pipes(ParticleStore& store, const CoreFields& f);
 
+  // Open sides with air (EmitterStage::room_sites): the sites that no particle is within `gap` [m] of, in
+  // increasing order, each with the kernel-weighted mean velocity of the moving particles around it, from
+  // the positions as they are now and the cells of the last build() (grid.cl, empty_sites). Nothing
+  // without room air. The sites are set once: set_room_sites.
+  struct EmptySites {
+    std::vector<std::uint32_t> site;
+    std::vector<Eigen::Vector3f> velocity;
+  };
+  void set_room_sites(const std::vector<Eigen::Vector3d>& sites);
+  EmptySites empty_sites(ParticleStore& store, const CoreFields& f, double gap);
+
   NeighbourView view() const { return {soa_, layout_.stride, cell_start_, cl_grid(info_)}; }
   const GridInfo& info() const { return info_; }
   const cl::Buffer& cell_start() const { return cell_start_; }
@@ -65,9 +76,12 @@ class NeighbourGrid {
   std::vector<cl_uint2> flagged_;  // (index, flag) of the particles intake_flags listed
   std::uint32_t ncells_ = 0, sort_passes_ = 0, radix_bits_ = 8;
   cl_uint blowing_ = 0;  // air dryers blowing at the last build()
-  cl::Kernel k_pipe_drive_, k_intake_flags_, k_set_flags_, k_cell_keys_, k_hist_, k_chunk_counts_,
-      k_scan_chunks_, k_scan_tiles_, k_scatter_, k_starts_;
-  cl::Buffer keys_[2], order_[2], hist_, totals_, chunks_, cell_start_, soa_, intakes_, take_, listed_, list_;
+  float support_ = 0;
+  cl_uint room_sites_ = 0;
+  cl::Kernel k_empty_sites_, k_pipe_drive_, k_intake_flags_, k_set_flags_, k_cell_keys_, k_hist_,
+      k_chunk_counts_, k_scan_chunks_, k_scan_tiles_, k_scatter_, k_starts_;
+  cl::Buffer keys_[2], order_[2], hist_, totals_, chunks_, cell_start_, soa_, intakes_, take_, listed_, list_,
+      sites_, site_out_, empty_, site_vel_;
 };
 
 }  // namespace thaw

@@ -64,7 +64,47 @@ void add(HostParticles& p, const Vec3& x, const Vec3& v, float mass, Phase phase
   p.anchored.push_back(anchored ? 1 : 0);
 }
 
+// The air's region on the domain's lattice, less the solids (which never move) and the air dryers' pipes:
+// an air dryer's pipe holds its own air, laid as it blows (sim/emitters.h), and room air there would be
+// taken in at the first step.
+std::vector<Vec3> air_lattice(const Scene& scene) {
+  const double dx = scene.spacing;
+  std::vector<Vec3> points =
+      voxelize(Shape::box(scene.air.region.min, scene.air.region.max), dx, &scene.domain.min);
+  drop_outside(points, scene.domain);
+  for (const auto& s : scene.solids) drop_inside(points, s);
+  for (const Dryer& d : scene.dryers) {
+    if (d.model != DryerModel::Air) continue;
+    const double pipe = EmitterStage::pipe_length(scene), r = EmitterStage::pipe_radius(d, dx);
+    std::vector<std::uint8_t> in_pipe(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Vec3 x = points[i] - d.position;
+      const double along = x.dot(d.direction);
+      in_pipe[i] = along >= -pipe && along < 0 && (x - along * d.direction).squaredNorm() < r * r;
+    }
+    drop(points, in_pipe);
+  }
+  return points;
+}
+
 }  // namespace
+
+std::vector<Eigen::Vector3d> room_air_sites(const Scene& scene) {
+  if (!scene.has_air() || !scene.open_faces) return {};
+  std::vector<Vec3> points = air_lattice(scene);
+  const double dx = scene.spacing;
+  std::vector<std::uint8_t> deep(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    bool near = false;
+    for (int a = 0; a < 3; ++a) {
+      if (scene.open_faces & (1u << (2 * a))) near = near || points[i][a] - scene.domain.min[a] < dx;
+      if (scene.open_faces & (2u << (2 * a))) near = near || scene.domain.max[a] - points[i][a] < dx;
+    }
+    deep[i] = !near;
+  }
+  drop(points, deep);
+  return points;
+}
 
 HostParticles sample_scene(const Scene& scene) {
   HostParticles p;
@@ -167,24 +207,9 @@ HostParticles sample_scene(const Scene& scene) {
     const AirFill& a = scene.air;
     const float mass = static_cast<float>(scene.materials[a.material].density * dx * dx * dx);
     const double h = enthalpy_at(scene, a.material, a.temperature);
-    std::vector<Vec3> points = voxelize(Shape::box(a.region.min, a.region.max), dx, &scene.domain.min);
-    drop_outside(points, scene.domain);
-    for (const auto& s : scene.solids) drop_inside(points, s);
+    std::vector<Vec3> points = air_lattice(scene);
     for (const auto& c : scene.ice) drop_inside(points, c.shape);
     for (const auto& f : scene.fluids) drop_inside(points, Shape::box(f.box.min, f.box.max));
-    // An air dryer's pipe holds its own air, laid as it blows (sim/emitters.h): room air there would be
-    // taken in at the first step.
-    for (const Dryer& d : scene.dryers) {
-      if (d.model != DryerModel::Air) continue;
-      const double pipe = EmitterStage::pipe_length(scene), r = EmitterStage::pipe_radius(d, dx);
-      std::vector<std::uint8_t> in_pipe(points.size());
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        const Vec3 x = points[i] - d.position;
-        const double along = x.dot(d.direction);
-        in_pipe[i] = along >= -pipe && along < 0 && (x - along * d.direction).squaredNorm() < r * r;
-      }
-      drop(points, in_pipe);
-    }
     if (points.empty())
       throw SceneError("air", "its region holds no particle outside the solids, ice and fluid blocks");
     for (const Vec3& x : points) add(p, x, Vec3::Zero(), mass, Phase::Air, a.material, h);

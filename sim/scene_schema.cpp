@@ -251,7 +251,9 @@ const Field& scene_schema() {
                   subset("open", {"-x", "+x", "-y", "+y", "-z", "+z"},
                          "Sides water may leave through: a fluid particle past one is removed and its mass, "
                          "momentum and enthalpy counted as outflow (metrics), rather than held at the face; "
-                         "not a side with a wall")
+                         "not a side with a wall. With air particles an open side is the room beyond: air "
+                         "leaves through it, and the room's air (at rest, at ambient.temperature) comes "
+                         "back in where a spacing next to the side has emptied, counted as inflow")
                       .def(Json::array()),
                   text("wall_material", "Material of the walls, a solid; required when walls is not empty")
                       .optional(),

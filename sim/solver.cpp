@@ -264,14 +264,16 @@ std::unique_ptr<RigidIce> make_rigid_ice(ClRuntime& cl, ParticleStore& store, co
                                     std::move(anchored_by_id), rigid_mass_scales(scene, k.rest_density));
 }
 
-// Room for the emitters' first second beside the particles there are; the solver grows it later.
-std::size_t first_capacity(const Scene& scene, std::size_t n) {
-  if (!EmitterStage::needed(scene)) return n;
+// Room for the emitters' first second, and a layer of room air, beside the particles there are; the solver
+// grows it later.
+std::size_t first_capacity(const Scene& scene, std::size_t n, const EmitterStage* emitters) {
+  if (!emitters) return n;
   double per_second = 0;
   for (const Emitter& e : scene.emitters) per_second += EmitterStage::particles_per_second(e, scene.spacing);
   for (const Dryer& d : scene.dryers)
     if (d.model == DryerModel::Air) per_second += EmitterStage::particles_per_second(d, scene.spacing);
-  return n + std::max<std::size_t>(1024, static_cast<std::size_t>(std::ceil(per_second)));
+  return n + std::max<std::size_t>(1024, static_cast<std::size_t>(std::ceil(per_second))) +
+         emitters->room_sites().size();
 }
 
 }  // namespace
@@ -294,7 +296,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   ids = std::max(ids, saved.next_id);
   if (ids > 0xffffffffull) throw Error("state: particle ids past 32 bits");
   next_id_ = static_cast<std::uint32_t>(ids);
-  if (capacity == 0) capacity = saved.capacity ? saved.capacity : first_capacity(scene_, n_);
+  if (capacity == 0) capacity = saved.capacity ? saved.capacity : first_capacity(scene_, n_, emitters_.get());
   layout_ = layout_for(n_, capacity, cl_.layout_tiles());
   const auto [lo, hi] = particle_bounds(scene_, p);
   const std::string opts = program_options(scene_);
@@ -311,6 +313,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   grid_built_ = false;
   f_ = add_core_fields(store_);
   grid_ = std::make_unique<NeighbourGrid>(cl_, scene_, k_.support, kGridReach, opts, layout_, lo, hi);
+  if (emitters_) grid_->set_room_sites(emitters_->room_sites());
   if (scene_.solver.flow)
     fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_, plan.build);
   if (fluid_ && scene_.solver.pressure == PressureSolver::Dfsph)
@@ -421,6 +424,12 @@ void Solver::emit(double dt) {
   const std::vector<double> before = emitters_->save({next_id_, layout_.capacity});
   const std::uint32_t first_id = next_id_;
   HostParticles in = emitters_->emit(time_ - dt, dt, next_id_);
+  // The room's air into the open sides' empty sites, on this step's grid (built at its start).
+  if (grid_built_ && !emitters_->room_sites().empty()) {
+    const NeighbourGrid::EmptySites empty =
+        grid_->empty_sites(store_, f_, EmitterStage::room_air_gap * scene_.spacing);
+    emitters_->admit_room_air(empty.site, empty.velocity, in, next_id_);
+  }
   if (in.size() == 0) return;
   if (n_ + in.size() > layout_.capacity) {
     // Out of room: rebuild every stage for half as many again (at least what is needed) from the state,

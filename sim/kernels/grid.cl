@@ -83,6 +83,49 @@ kernel void pipe_drive(global const float4* pos, global float4* vel, global cons
 #define THAW_INTAKE_ARG
 #endif
 
+/* Room air through open sides (-DTHAW_ROOM_AIR; sim/emitters.h). A site is listed (at an atomically
+ * counted slot; the host orders them) when no particle is within sqrt(gap2) of it, and the air around
+ * it, by its kernel-weighted mean velocity, is not leaving through the site's side (outward normal
+ * site_out[s]). That velocity goes to site_vel (zero where no particle moves): the room's air comes in
+ * as the air beside it moves, so a stream through an open side stays whole. Measured on a box whose air
+ * left through one side at up to 1 m/s (tests/sim/air_test.cpp, AirLeavesThroughOpenSides...): with a
+ * gap of 0.95 dx its air kept the rise g t exactly and the box held 87-100 % of its particles (a whole
+ * layer comes in at once). Laid at rest, it held 53 %; with a gap of 0.8 dx and also where air leaves,
+ * 47 %: the new air blocked the outflow; with a fill criterion (the sum of W at the site below the
+ * lattice's), the layers came in early, their pressure pushed them back, and it held 60-75 %. Run at the
+ * end of a step on the step's grid with the positions the drift left: a particle moves far less than a
+ * cell in a step, so the cells around a site still hold every particle near it. */
+#ifdef THAW_ROOM_AIR
+kernel void empty_sites(global const float4* pos, global const float4* vel, global const uchar* phase,
+                        global const uint* cell_start, const Grid g, global const float4* sites,
+                        global const float4* site_out, const uint count, const float gap2, const float H,
+                        volatile global uint* listed, global uint* list, global float4* site_vel) {
+  const uint s = get_global_id(0);
+  if (s >= count) return;
+  const float4 x = sites[s];
+  const int4 c = grid_cell(g, x);
+  float sw = 0.0f;
+  float3 sv = (float3)(0.0f);
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 xs = THAW_ROW_POS(g, c, x);
+    for (uint j = jb; j < je; ++j) {
+      const float3 d = xs.xyz - pos[j].xyz;
+      const float r2 = dot(d, d);
+      if (r2 < gap2) return;
+      if (r2 < H * H && !THAW_IS_STATIC(phase[j])) {
+        const float w = KERNEL_W(sqrt(r2), H);
+        sw += w;
+        sv += w * vel[j].xyz;
+      }
+    }
+  }
+  const float3 v = sw > 0.0f ? sv / sw : (float3)(0.0f);
+  if (dot(v, site_out[s].xyz) > 0.0f) return;
+  site_vel[s] = (float4)(v, 0.0f);
+  list[atomic_inc(listed)] = s;
+}
+#endif
+
 kernel void cell_keys(global float4* pos, global float4* vel, global const uchar* phase, global uint* keys,
                       global uint* order, volatile global uint* clamped, const Grid g,
                       const KeysParams P THAW_INTAKE_ARG) {
