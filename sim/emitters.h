@@ -30,7 +30,9 @@
 // air at the ambient temperature (ambient.temperature) that moves as the air around the site does,
 // booked here as inflow. So a plume rises out of an open top while still air beside it stays (no site
 // there is empty), and the particle count stays bounded where a closed side would hold every particle
-// that reaches it (clamped and counted).
+// that reaches it (clamped and counted). Measured limit (docs/ARCHITECTURE.md): the pressure solve
+// resists only compression, so pushes on the air vent some through an open side and nothing draws the
+// room's air back; the shipped air scenes lost 22-53 % of their air with the top open, and hold it.
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
