@@ -60,22 +60,24 @@ void EmitterStage::admit_room_air(const std::vector<std::uint32_t>& empty,
   const float mass =
       static_cast<float>(scene_.materials[static_cast<std::size_t>(air)].density * dx * dx * dx);
   const double h = enthalpy_at(scene_, air, scene_.heat.ambient_temperature);
+  for (std::size_t k = 0; k < empty.size(); ++k)
+    append(out, room_sites_.at(empty[k]), velocity.at(k), mass, Phase::Air, air, h, next_id);
+}
+
+void EmitterStage::append(HostParticles& out, const Eigen::Vector3d& x, const Eigen::Vector3f& v, float mass,
+                          Phase phase, int material, double h, std::uint32_t& next_id) {
   const float h_hi = static_cast<float>(h), h_lo = static_cast<float>(h - double(h_hi));
-  for (std::size_t k = 0; k < empty.size(); ++k) {
-    const Eigen::Vector3d& x = room_sites_.at(empty[k]);
-    const Eigen::Vector3f& v = velocity.at(k);
-    out.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
-    out.velocity.push_back({v.x(), v.y(), v.z(), 0.f});
-    out.density.push_back(0.f);
-    out.phase.push_back(static_cast<std::uint8_t>(Phase::Air));
-    out.material.push_back(static_cast<std::uint8_t>(air));
-    out.id.push_back(next_id++);
-    out.enthalpy.push_back({h_hi, h_lo});
-    out.anchored.push_back(0);
-    books_.particles += 1;
-    books_.mass += double(mass);
-    books_.momentum += double(mass) * v.cast<double>();
-  }
+  out.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
+  out.velocity.push_back({v.x(), v.y(), v.z(), 0.f});
+  out.density.push_back(0.f);
+  out.phase.push_back(static_cast<std::uint8_t>(phase));
+  out.material.push_back(static_cast<std::uint8_t>(material));
+  out.id.push_back(next_id++);
+  out.enthalpy.push_back({h_hi, h_lo});
+  out.anchored.push_back(0);
+  books_.particles += 1;
+  books_.mass += double(mass);
+  books_.momentum += double(mass) * v.cast<double>();
 }
 
 std::size_t EmitterStage::lay(const Nozzle& z, double open_for, double& pending, HostParticles& out,
@@ -90,27 +92,13 @@ std::size_t EmitterStage::lay(const Nozzle& z, double open_for, double& pending,
   const Material& m = scene_.materials[static_cast<std::size_t>(z.material)];
   const float mass = static_cast<float>(m.density * dx * dx * dx);
   const double h = enthalpy_at(scene_, z.material, z.temperature);
-  const float h_hi = static_cast<float>(h), h_lo = static_cast<float>(h - double(h_hi));
-  const Eigen::Vector3d v = z.speed * z.direction;
+  const Eigen::Vector3f v = (z.speed * z.direction).cast<float>();
   while (pending >= d) {
     pending -= d;
     // This disc crossed the nozzle when the pending length reached d: it has since gone the rest.
     const Eigen::Vector3d centre = z.position + pending * z.direction;
-    for (const Eigen::Vector2i& o : offsets) {
-      const Eigen::Vector3d x = centre + dx * (o.x() * u + o.y() * w);
-      out.position.push_back({float(x.x()), float(x.y()), float(x.z()), mass});
-      out.velocity.push_back({float(v.x()), float(v.y()), float(v.z()), 0.f});
-      out.density.push_back(0.f);
-      out.phase.push_back(static_cast<std::uint8_t>(z.phase));
-      out.material.push_back(static_cast<std::uint8_t>(z.material));
-      out.id.push_back(next_id++);
-      out.enthalpy.push_back({h_hi, h_lo});
-      out.anchored.push_back(0);
-      books_.particles += 1;
-      books_.mass += double(mass);
-      books_.momentum +=
-          double(mass) * Eigen::Vector3d(double(float(v.x())), double(float(v.y())), double(float(v.z())));
-    }
+    for (const Eigen::Vector2i& o : offsets)
+      append(out, centre + dx * (o.x() * u + o.y() * w), v, mass, z.phase, z.material, h, next_id);
   }
   return out.size() - before;
 }

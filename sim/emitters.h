@@ -116,6 +116,10 @@ class EmitterStage {
     int material;
     Phase phase;
   };
+  // Appends one particle of `material` at x moving at v with enthalpy h (split into float hi + lo) and the
+  // next id, and books it: what lay() and admit_room_air() share.
+  void append(HostParticles& out, const Eigen::Vector3d& x, const Eigen::Vector3f& v, float mass, Phase phase,
+              int material, double h, std::uint32_t& next_id);
   // Returns the particles laid.
   std::size_t lay(const Nozzle& z, double open_for, double& pending, HostParticles& out,
                   std::uint32_t& next_id);

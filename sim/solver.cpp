@@ -772,7 +772,9 @@ std::vector<std::string> Solver::stages() const {
     out.push_back("photons (when a lamp is on)");
   if (heat_) out.push_back("heat (" + heat_reason_ + ")");
   if (fluid_) out.push_back("integrate");
-  if (emitters_) out.push_back("emit");
+  // A scene without taps or dryers has this stage for its open sides: say so.
+  if (emitters_)
+    out.push_back(EmitterStage::admits_room_air(scene_) ? "emit (room air through open sides)" : "emit");
   return out;
 }
 
