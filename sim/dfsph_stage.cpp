@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "sim/cl_launch.h"
+#include "sim/fluid_stage.h"
 #include "sim/kernels/sph_kernel.h"
 #include "sim/solver.h"
 
@@ -28,9 +29,14 @@ double dfsph_rest_ratio(const Scene& scene) {
 }
 
 DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-                       const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
-                       const cl::Buffer& flow)
-    : cl_(cl), store_(store), f_(core), layout_(layout), flow_(flow) {
+                       const SolverConstants& k, const std::string& build_options,
+                       const ParticleLayout& layout, const cl::Buffer& flow, bool with_heat)
+    : cl_(cl),
+      store_(store),
+      f_(core),
+      layout_(layout),
+      flow_(flow),
+      ideal_gas_(rest_density_reads_temperature(scene, with_heat)) {
   // The accumulated (sum kappa dt^2, sum kappa dt) of the step's two solves: the next step's warm start,
   // saved so that a resumed run continues bitwise.
   kappa_ = store.add({"dfsph_kappa", FieldType::Float32, 2});
@@ -43,6 +49,7 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   if (extrapolate_) relaxation << " -DTHAW_DFSPH_EXTRAPOLATE";
   // The density solve's target: the density a resting lattice sums to (dfsph.cl, dfsph_error).
   relaxation << " -DTHAW_DFSPH_LATTICE=" << dfsph_rest_ratio(scene) << "f";
+  if (ideal_gas_) relaxation << " -DTHAW_IDEAL_GAS";
   const auto program = cl.build(
       {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph_columns.h", "dfsph.cl"},
       relaxation.str());
@@ -84,6 +91,7 @@ void DfsphStage::mark_fluid() {
   if (layout_.n == 0) return;
   set_args(k_columns_, store_[f_.position], store_[f_.phase], store_[f_.material], flow_, col_,
            layout_.stride, static_cast<cl_uint>(layout_.n));
+  if (ideal_gas_) k_columns_.setArg(7, store_[enthalpy_]);
   launch(cl_.queue(), k_columns_, layout_.n);
 }
 

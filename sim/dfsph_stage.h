@@ -45,10 +45,13 @@ struct PressureSolveTotals {
 
 class DfsphStage {
  public:
-  // `flow` is the fluid stage's material table (each particle's rest density).
+  // `flow` is the fluid stage's material table (each particle's rest density). `with_heat`: the heat stage
+  // runs, so ideal-gas air's rest density follows its temperature (rest_density_reads_temperature).
   DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
              const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
-             const cl::Buffer& flow);
+             const cl::Buffer& flow, bool with_heat);
+  // With rest_density_reads_temperature(): the enthalpy field the columns read (the heat stage's).
+  void rest_density_from(ParticleStore::Field enthalpy) { enthalpy_ = enthalpy; }
 
   // After the grid's sort, before the density pass: who is fluid (the density pass then computes alpha for
   // both solves into columns(): FluidStage::compute_dfsph_alpha).
@@ -92,6 +95,8 @@ class DfsphStage {
       k_extrapolate_;
   cl_float4 gravity_{};
   bool divergence_warm_start_ = false;  // solver.divergence_warm_start
+  bool ideal_gas_ = false;              // THAW_IDEAL_GAS: the columns read the enthalpy (eq 7)
+  ParticleStore::Field enthalpy_ = 0;
   bool extrapolate_ = true;  // solver.boundary_pressure adami2012; akinci2012 leaves the boundary's kappa 0
   cl::Buffer col_, sums_;
   PressureSolve last_density_, last_divergence_;

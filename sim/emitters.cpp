@@ -57,9 +57,9 @@ void EmitterStage::admit_room_air(const std::vector<std::uint32_t>& empty,
   if (empty.empty()) return;
   const double dx = scene_.spacing;
   const int air = scene_.air.material;
-  const float mass =
-      static_cast<float>(scene_.materials[static_cast<std::size_t>(air)].density * dx * dx * dx);
-  const double h = enthalpy_at(scene_, air, scene_.heat.ambient_temperature);
+  const double T = scene_.heat.ambient_temperature;
+  const float mass = static_cast<float>(rest_density_at(scene_, air, T) * dx * dx * dx);
+  const double h = enthalpy_at(scene_, air, T);
   for (std::size_t k = 0; k < empty.size(); ++k)
     append(out, room_sites_.at(empty[k]), velocity.at(k), mass, Phase::Air, air, h, next_id);
 }
@@ -89,8 +89,7 @@ std::size_t EmitterStage::lay(const Nozzle& z, double open_for, double& pending,
   const double d = spacing_of(offsets.size(), z.radius, dx);
   if (pending < d) return 0;
   const Eigen::Vector3d u = z.direction.unitOrthogonal(), w = z.direction.cross(u);
-  const Material& m = scene_.materials[static_cast<std::size_t>(z.material)];
-  const float mass = static_cast<float>(m.density * dx * dx * dx);
+  const float mass = static_cast<float>(rest_density_at(scene_, z.material, z.temperature) * dx * dx * dx);
   const double h = enthalpy_at(scene_, z.material, z.temperature);
   const Eigen::Vector3f v = (z.speed * z.direction).cast<float>();
   while (pending >= d) {

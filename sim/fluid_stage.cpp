@@ -47,12 +47,30 @@ std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const S
       f.artificial_buoyancy = static_cast<float>(air.artificial_buoyancy);
       f.max_temperature = static_cast<float>(air.max_temperature);
       f.inv_specific_heat = static_cast<float>(1.0 / m.specific_heat);
-      if (air.buoyancy == Buoyancy::Boussinesq) {
-        f.expansion = static_cast<float>(air.expansion);
+      if (air.buoyancy == Buoyancy::IdealGas) {
+        // Eq 7's rest density follows the temperature in the pressure solve (dfsph_columns); without heat
+        // every air particle keeps its starting one.
+        if (with_heat)
+          f.theta = static_cast<float>(air.theta);
+        else
+          f.rest_density = static_cast<float>(ideal_gas_rest_density(m.density, air, air.temperature));
+      }
+      if (air.buoyancy != Buoyancy::None) {
+        // The weight: g - grad p / rho0(T). The air's hydrostatic pressure at its reference density rho_r
+        // (the material's, at T0) is left out of p, as Boussinesq's rho0 g is (sim/scene.h): what stays is
+        // g (1 - rho_r / rho0(T)), and with eq 7 that is exactly -theta (T - T0) / (1 + theta T0) g, a
+        // Boussinesq force of expansion theta / (1 + theta T0) (1 / (T0 + 273.15 K) for the ideal gas).
+        // Kept in p, the air's weight made a pressure about 30 times the buoyancy's, whose symmetric pair
+        // terms held the cavity's circulation at half de Vahl Davis's speed (u_max 1.76 alpha/L
+        // against 3.65).
+        f.expansion = static_cast<float>(air.buoyancy == Buoyancy::IdealGas
+                                             ? air.theta / (1.0 + air.theta * air.reference_temperature)
+                                             : air.expansion);
         f.reference_temperature = static_cast<float>(air.reference_temperature);
         // Without heat every air particle stays at its starting temperature: its buoyancy is a constant.
         if (!with_heat)
-          f.gravity = static_cast<float>(-air.expansion * (air.temperature - air.reference_temperature));
+          f.gravity =
+              static_cast<float>(-double(f.expansion) * (air.temperature - air.reference_temperature));
       }
       // Eq 8 at the starting temperature, as a share of gravity (against it), likewise.
       if (!with_heat && air.artificial_buoyancy > 0 && scene.gravity.norm() > 0)
@@ -64,10 +82,15 @@ std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const S
   return table;
 }
 
+bool rest_density_reads_temperature(const Scene& scene, bool with_heat) {
+  return with_heat && scene.solver.flow && scene.solver.pressure == PressureSolver::Dfsph &&
+         scene.has_air() && scene.air.buoyancy == Buoyancy::IdealGas;
+}
+
 bool buoyancy_reads_temperature(const Scene& scene, bool with_heat) {
   return with_heat && scene.has_air() &&
          ((scene.air.buoyancy == Buoyancy::Boussinesq && scene.air.expansion > 0) ||
-          scene.air.artificial_buoyancy > 0);
+          scene.air.buoyancy == Buoyancy::IdealGas || scene.air.artificial_buoyancy > 0);
 }
 
 FluidStage::FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,

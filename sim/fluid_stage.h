@@ -33,6 +33,9 @@ fluid::MaterialFlow flow_row(const SolverSettings& s, float rest_density, float 
 std::vector<fluid::MaterialFlow> material_flow_table(const Scene& scene, const SolverConstants& k,
                                                      bool with_heat = false);
 
+// Whether the DFSPH columns read each air particle's temperature for its rest density (eq 7).
+bool rest_density_reads_temperature(const Scene& scene, bool with_heat);
+
 // Whether the forces pass reads each particle's temperature: Boussinesq air in a run with heat.
 bool buoyancy_reads_temperature(const Scene& scene, bool with_heat);
 

@@ -37,7 +37,17 @@ const char* name(MaterialKind k) {
   }
   return "?";
 }
-const char* name(Buoyancy b) { return b == Buoyancy::Boussinesq ? "boussinesq" : "none"; }
+const char* name(Buoyancy b) {
+  switch (b) {
+    case Buoyancy::Boussinesq:
+      return "boussinesq";
+    case Buoyancy::IdealGas:
+      return "ideal_gas";
+    case Buoyancy::None:
+      break;
+  }
+  return "none";
+}
 const char* name(KernelFunction k) {
   return k == KernelFunction::WendlandC2 ? "wendland_c2" : "cubic_spline";
 }
@@ -306,7 +316,9 @@ AirFill air_fill_from_json(const Json& a, const Scene& s, const Json& materials)
     check_inside(s.domain, air.region, "air.region");
   }
   air.temperature = temperature_or(a, s.heat.ambient_temperature);
-  air.buoyancy = choice_of<Buoyancy>(a["buoyancy"], {Buoyancy::None, Buoyancy::Boussinesq});
+  air.buoyancy =
+      choice_of<Buoyancy>(a["buoyancy"], {Buoyancy::None, Buoyancy::Boussinesq, Buoyancy::IdealGas});
+  air.theta = a["theta"].get<double>();
   air.reference_temperature =
       a.contains("reference_temperature") ? a["reference_temperature"].get<double>() : air.temperature;
   air.expansion =
@@ -316,6 +328,13 @@ AirFill air_fill_from_json(const Json& a, const Scene& s, const Json& materials)
   air.max_temperature = a["max_temperature"].get<double>();
   air.face_depth = a["face_exchange_depth"].get<double>();
   if (air.face_depth == 0) air.face_depth = s.solver.support_ratio * s.spacing;
+  // Eq 7's denominator 1 + theta T: the kernel holds it at 0.1 or more (dfsph.cl); a scene whose air
+  // starts or is referred to below that has a theta too large for its temperatures.
+  if (air.buoyancy == Buoyancy::IdealGas)
+    for (const double t : {air.temperature, air.reference_temperature})
+      if (1.0 + air.theta * t < 0.1)
+        throw SceneError("air.theta", "1 + theta T = " + format_number(1.0 + air.theta * t) + " at " +
+                                          format_number(t) + " °C; eq 7 needs it above 0.1");
   return air;
 }
 
@@ -872,6 +891,11 @@ void apply_override(Json& doc, const std::string& assignment, const Field& schem
 
 void check_multiphase(const Scene& s) {
   if (!s.solver.flow || !s.multiphase()) return;
+  if (s.solver.pressure != PressureSolver::Dfsph && !s.several_rest_densities())
+    throw SceneError("air.buoyancy",
+                     "'ideal_gas' gives every air particle its own rest density, which needs "
+                     "solver.pressure 'dfsph' (its multiphase form, Hu & Adams 2006); with 'wcsph' use "
+                     "'boussinesq'");
   if (s.solver.pressure != PressureSolver::Dfsph)
     throw SceneError("solver.pressure",
                      "fluids of several rest densities (air beside water, or beside the water the ice melts "
@@ -880,12 +904,26 @@ void check_multiphase(const Scene& s) {
   // Two incompressible fluids sealed in a box must fill it exactly: what the water's tolerance leaves over
   // goes to the air, which the solve cannot relieve, and the run blows up (docs/VALIDATION-RESULTS.md,
   // air-water). Air in a real closed box would give way; ours is not compressible yet.
-  if (s.has_air() && s.walls.size() >= 6)
+  if (s.has_air() && s.several_rest_densities() && s.walls.size() >= 6)
     throw SceneError(
         "domain.walls",
         "air beside water needs an open side of the domain (leave one of the six walls out, e.g. "
         "\"+z\", the room above): sealed in, the two incompressible fluids cannot make room "
         "for each other");
+}
+
+double ideal_gas_rest_density(double material_density, const AirFill& air, double temperature) {
+  // rho0(T) = rho0(0 °C) / (1 + theta T) (eq 7), with rho0(0 °C) = rho (1 + theta T0); the denominator
+  // held at 0.1 as in dfsph.cl.
+  return material_density * (1.0 + air.theta * air.reference_temperature) /
+         std::max(1.0 + air.theta * temperature, 0.1);
+}
+
+double rest_density_at(const Scene& scene, int material, double temperature) {
+  const double rho = scene.materials.at(static_cast<std::size_t>(material)).density;
+  if (scene.has_air() && material == scene.air.material && scene.air.buoyancy == Buoyancy::IdealGas)
+    return ideal_gas_rest_density(rho, scene.air, temperature);
+  return rho;
 }
 
 std::vector<double> Scene::fluid_rest_densities() const {
@@ -900,15 +938,20 @@ std::vector<double> Scene::fluid_rest_densities() const {
   return rest;
 }
 
-bool Scene::multiphase() const {
+bool Scene::several_rest_densities() const {
   const auto rest = fluid_rest_densities();
   return std::any_of(rest.begin(), rest.end(), [&](double d) { return d != rest.front(); });
+}
+
+bool Scene::multiphase() const {
+  return several_rest_densities() || (has_air() && air.buoyancy == Buoyancy::IdealGas);
 }
 
 double Scene::rest_density_split() const {
   const auto rest = fluid_rest_densities();
   if (rest.empty()) return 0;
   const auto [lo, hi] = std::minmax_element(rest.begin(), rest.end());
+  if (*hi == *lo) return 0;  // one fluid (ideal-gas air alone): the walls' pressure as for water
   // Only a gas-like contrast makes a light fluid (its walls mirror its own pressure, dfsph.cl): two
   // liquids (water and a syrup 10 % denser) both take the walls' extrapolated pressure.
   return *hi >= 5.0 * *lo ? std::sqrt(*lo * *hi) : 0.5 * *lo;

@@ -79,9 +79,13 @@ struct Material {
 // How air's density follows its temperature. Boussinesq: the momentum equation keeps the density rho0
 // except in the body force, rho0 g (1 - beta (T - T0)) (de Vahl Davis 1983's problem); the uniform part
 // rho0 g only makes the air's own hydrostatic pressure, a few pascals, and is left out, so the air feels
-// -beta (T - T0) g alone. None: air feels no gravity at all.
-enum class Buoyancy { None, Boussinesq };
-const char* name(Buoyancy b);  // "none", "boussinesq"
+// -beta (T - T0) g alone. IdealGas: Domaradzki & Martyn's eq 7, each air particle's rest density
+// rho0(T) = rho0(0 °C) / (1 + theta T) follows its temperature (with theta = 1/273.15 K, Charles's law:
+// the ideal gas at constant pressure) in the pressure solve's rest volumes (dfsph.cl), so warm air
+// expands, and it feels its weight less that of air at T0, g (1 - rho0(T0) / rho0(T)) (the reference
+// air's hydrostatic pressure left out as Boussinesq's is). None: air feels no gravity at all.
+enum class Buoyancy { None, Boussinesq, IdealGas };
+const char* name(Buoyancy b);  // "none", "boussinesq", "ideal_gas"
 
 // The scene's air particles (`air`): a region filled on the particle lattice with an air material,
 // except where fluid, ice or solids are.
@@ -92,6 +96,9 @@ struct AirFill {
   Buoyancy buoyancy = Buoyancy::Boussinesq;
   double reference_temperature = 20.0;  // T0 [°C]
   double expansion = 1.0 / 293.15;      // beta [1/K]; an ideal gas's 1 / (T0 + 273.15) unless given
+  // Eq 7's theta [1/K] (IdealGas): rho0(T) = rho_material (1 + theta T0) / (1 + theta T), the material's
+  // density being the air's at T0. 1/273.15: the ideal gas; the paper set 0.005 by experiment.
+  double theta = 1.0 / 273.15;
   // Domaradzki & Martyn sec. 7 (Fig. 6): air within face_depth of a side of the domain that is not
   // periodic relaxes toward heat.ambient_temperature with time constant face_time, so a dryer does not
   // heat a closed room without end; booked as ambient exchange. face_time 0: off.
@@ -247,10 +254,14 @@ struct Scene {
   // How many dryers blow air particles (dryers[].model "air").
   std::size_t air_dryer_count() const;
   // Fluids of more than one rest density can meet: air beside water, or beside the water ice melts into.
-  // The fluid passes are then built with the number-density multiphase form (sim/kernels/dfsph.cl).
+  bool several_rest_densities() const;
+  // The fluid passes are built with the number-density multiphase form (sim/kernels/dfsph.cl): where
+  // fluids of several rest densities meet, and where the air's rest density follows its temperature
+  // (air.buoyancy ideal_gas).
   bool multiphase() const;
   // Between the light fluids' rest densities and the heavy ones' (their geometric mean) where they differ
-  // five-fold or more, else below them all: the multiphase passes tell air from water by it.
+  // five-fold or more, else below them all (0 where there is one: nothing is light): the multiphase
+  // passes tell air from water by it.
   double rest_density_split() const;
   // The rest densities of every fluid the scene has or makes (blocks, emitters, melted ice, air).
   std::vector<double> fluid_rest_densities() const;
@@ -319,6 +330,14 @@ Scene load_scene(const std::string& file, const std::vector<std::string>& overri
 // Refuses a scene whose fluids of several rest densities meet under a solver without a multiphase form,
 // at solver.pressure.
 void check_multiphase(const Scene& scene);
+
+// Domaradzki & Martyn eq 7 (air.buoyancy ideal_gas): the rest density of `air` of a material of this
+// density (the air's at air.reference_temperature) at `temperature` [°C].
+double ideal_gas_rest_density(double material_density, const AirFill& air, double temperature);
+// The rest density of a new particle of fluid `material` at `temperature`: the material's, or eq 7's for
+// the scene's air when its buoyancy is ideal_gas. New particles (the fill, the emitters, the room's air)
+// weigh this times dx^3, so that they start at rest on the lattice.
+double rest_density_at(const Scene& scene, int material, double temperature);
 
 Scene scene_from_json(Json doc, const std::vector<std::string>& overrides = {},
                       const std::string& folder = "");

@@ -205,7 +205,7 @@ HostParticles sample_scene(const Scene& scene) {
   // Air: the domain's lattice over its region, skipping points inside solids, ice or fluid blocks.
   if (scene.has_air()) {
     const AirFill& a = scene.air;
-    const float mass = static_cast<float>(scene.materials[a.material].density * dx * dx * dx);
+    const float mass = static_cast<float>(rest_density_at(scene, a.material, a.temperature) * dx * dx * dx);
     const double h = enthalpy_at(scene, a.material, a.temperature);
     std::vector<Vec3> points = air_lattice(scene);
     for (const auto& c : scene.ice) drop_inside(points, c.shape);

@@ -431,10 +431,21 @@ const Field& scene_schema() {
                       .above(-273.15)
                       .at_most(3000)
                       .optional(),
-                  choice("buoyancy", {"boussinesq", "none"},
+                  choice("buoyancy", {"boussinesq", "ideal_gas", "none"},
                          "boussinesq: warm air rises, feeling -beta (T - T0) g (its own weight is left to a "
-                         "hydrostatic pressure of a few pascals); none: air feels no gravity")
+                         "hydrostatic pressure of a few pascals); ideal_gas: Domaradzki & Martyn's eq 7, "
+                         "each particle's rest density rho0 (1 + theta T0) / (1 + theta T) follows its "
+                         "temperature: warm air expands, and rises by its weight less that of air at T0 "
+                         "(needs solver.pressure dfsph); "
+                         "none: air feels no gravity")
                       .def("boussinesq"),
+                  number("theta",
+                         "ideal_gas: eq 7's theta, how fast the rest density falls with temperature; "
+                         "1/273.15 K is the ideal gas (Charles's law), the paper chose 0.005 by experiment")
+                      .in("1/K")
+                      .def(1.0 / 273.15)
+                      .above(0)
+                      .at_most(0.01),
                   number("reference_temperature",
                          "T0, where air has its rest density; default its temperature")
                       .in("°C")

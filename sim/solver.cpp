@@ -317,7 +317,8 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   if (scene_.solver.flow)
     fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_, plan.build);
   if (fluid_ && scene_.solver.pressure == PressureSolver::Dfsph)
-    dfsph_ = std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow());
+    dfsph_ =
+        std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow(), plan.build);
   if (dfsph_) fluid_->compute_dfsph_alpha(dfsph_->columns(), dfsph_->min_neighbours());
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
   if (rigid_ && fluid_ && dfsph_ && scene_.multiphase()) rigid_->use_flow_table(fluid_->flow());
@@ -327,6 +328,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   if (plan.build)
     heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
   if (fluid_ && heat_) fluid_->buoyancy_from(heat_->enthalpy());
+  if (dfsph_ && heat_) dfsph_->rest_density_from(heat_->enthalpy());
   store_.allocate(layout_.capacity);
   store_.resize(n_);
 

@@ -25,8 +25,13 @@ kernel void density(global const float4* pos, global const float* soa, global co
   const float H = P.support;
   /* The particle's material's rest density and stiffness (fluid_params.h). */
   const MaterialFlow mf = flow[material[i]];
-  const float rho0 = mf.rest_density, B = mf.stiffness;
   const float4 pi = pos[i];
+#ifdef THAW_MULTIPHASE
+  /* The particle's own rest density m / V (dfsph_columns: the material's, or eq 7's for ideal-gas air). */
+  const float rho0 = pi.w / col[COL_VOL * stride + i], B = mf.stiffness;
+#else
+  const float rho0 = mf.rest_density, B = mf.stiffness;
+#endif
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
   const float inv_H = 1.0f / H;
@@ -192,9 +197,9 @@ kernel void density(global const float4* pos, global const float* soa, global co
    * particle's kinematic one negated (the pair takes it at the fluid's own density, as in one fluid), and
    * the volume m_j / rho_j, which the pair term weighs symmetrically (DFSPH: no pressure term there). */
 #ifdef THAW_NO_SLIP
-  derived[i] = boundary ? -mf.viscosity : mf.viscosity * rho0;
+  derived[i] = boundary ? -mf.viscosity : mf.viscosity * mf.rest_density;
 #else
-  derived[i] = boundary ? -P.visc_boundary : mf.viscosity * rho0;
+  derived[i] = boundary ? -P.visc_boundary : mf.viscosity * mf.rest_density;
 #endif
   derived[stride + i] = pi.w / rho;
 #else

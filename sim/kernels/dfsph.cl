@@ -91,11 +91,29 @@
 /* FM: who is fluid, as the lanes of the other passes (and the density pass's alpha) read it; run after the
  * grid's sort, before the density pass. */
 kernel void dfsph_columns(global const float4* pos, global const uchar* phase, global const uchar* material,
-                          global const MaterialFlow* flow, global float* col, const uint stride, const uint n) {
+                          global const MaterialFlow* flow, global float* col, const uint stride, const uint n
+#ifdef THAW_IDEAL_GAS
+                          ,
+                          global const float2* enthalpy
+#endif
+) {
   const uint i = get_global_id(0);
   if (i >= n) return;
 #ifdef THAW_MULTIPHASE
-  const float rho0 = flow[material[i]].rest_density;
+  float rho0 = flow[material[i]].rest_density;
+#ifdef THAW_IDEAL_GAS
+  /* Domaradzki & Martyn eq 7, rho0(T) = rho0(0 °C) / (1 + theta T), with the material's density that at
+   * T0 (fluid_params.h; theta 0 for every material but ideal-gas air). The constraint Σ V_j W_ij = 1 then
+   * makes room for warm air's larger rest volume (the expansion Boussinesq leaves out), and the pressure
+   * moves it by 1/rho0_i (dfsph_correct: its inertia); its weight less the reference air's is the forces
+   * pass's (fluid_stage.cpp). Written here, after the sort, so every pass of the step reads one V. */
+  const float theta = flow[material[i]].theta;
+  if (theta > 0.0f) {
+    const float2 h = enthalpy[i];
+    const float T = (h.x + h.y) * flow[material[i]].inv_specific_heat;
+    rho0 *= (1.0f + theta * flow[material[i]].reference_temperature) / fmax(1.0f + theta * T, 0.1f);
+  }
+#endif
   const float v = pos[i].w / rho0;
   col[COL_VOL * stride + i] = v;
   col[COL_FM * stride + i] = THAW_IS_STATIC(phase[i]) ? 0.0f : v / rho0;
@@ -158,8 +176,10 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
     /* Fractions of the particle's own rest density (the header), compression only as in one fluid
      * (Domaradzki & Martyn's eq 6 clamps the interface so too). Correcting expansion as well where the
      * neighbourhood is full blew the air-over-water tank up within 50 steps: the Jacobi sweeps then
-     * pull the water's top layer into the air and back. */
-    err = fmax(rho / flow[material[i]].rest_density + dt * rate - THAW_DFSPH_LATTICE, 0.0f);
+     * pull the water's top layer into the air and back. In ideal-gas air alone (the cavity, Ra 1e3, res
+     * 20) it diverged in the first step, the mean error doubling every sweep: relaxed Jacobi with this
+     * diagonal holds only while the clamp cuts its overshoot off. */
+    err = fmax(rho * col[COL_VOL * stride + i] / pi.w + dt * rate - THAW_DFSPH_LATTICE, 0.0f); /* rho / rho0_i */
 #else
     const float rho0 = flow[material[i]].rest_density * THAW_DFSPH_LATTICE;
     err = fmax(rho + dt * rate - rho0, 0.0f);

@@ -28,6 +28,10 @@ typedef struct {
    * sigma / (T_max - T) [m/s^2], with T_max - T no less than 1 K; sigma 0: off. */
   float artificial_buoyancy; /* sigma [K m/s^2] */
   float max_temperature;     /* T_max [°C] */
+  /* Domaradzki & Martyn's eq 7 (air.buoyancy ideal_gas, builds with THAW_IDEAL_GAS): the particle's rest
+   * density rest_density (1 + theta reference_temperature) / (1 + theta T), T from its enthalpy as above
+   * (dfsph_columns); 0: its rest density is rest_density. */
+  float theta; /* [1/K] */
 } MaterialFlow;
 
 typedef struct {
@@ -52,7 +56,7 @@ typedef struct {
 } ForcesParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(MaterialFlow) == 44, "MaterialFlow must match its OpenCL layout");
+static_assert(sizeof(MaterialFlow) == 48, "MaterialFlow must match its OpenCL layout");
 static_assert(sizeof(DensityParams) == 32, "DensityParams must match its OpenCL layout");
 static_assert(sizeof(ForcesParams) == 48, "ForcesParams must match its OpenCL layout");
 }  // namespace thaw::fluid

@@ -1,7 +1,8 @@
 // Natural convection around a cold sphere in still air (issue 18's `air-sphere`): a sphere of diameter D
 // held at T_s (0 °C: ice that does not melt) in a closed box of air at T_inf (20 °C), Boussinesq
-// buoyancy. The air it cools sinks below it as a plume. Reference: Churchill's correlation for a sphere
-// (Churchill 1983, as quoted by Incropera & DeWitt eq 9.35, valid for Pr >= 0.7 and Ra <= 1e11)
+// buoyancy (or eq 7's ideal gas, `buoyancy`). The air it cools sinks below it as a plume. Reference:
+// Churchill's correlation for a sphere (Churchill 1983, as quoted by Incropera & DeWitt eq 9.35, valid for Pr
+// >= 0.7 and Ra <= 1e11)
 //   Nu = 2 + 0.589 Ra^(1/4) / [1 + (0.469 / Pr)^(9/16)]^(4/9),  Ra = g beta |T_inf - T_s| D^3 / (nu alpha),
 // with beta the air's expansion coefficient as the run uses it (an ideal gas's 1 / (T_inf + 273.15 K)),
 // so the reference follows every parameter. Metric: Nu = Q / (pi D k |T_inf - T_s|), Q the heat the air
@@ -33,6 +34,9 @@ Field params() {
           .above(-100)
           .at_most(500),
       number("gravity", "g").in("m/s^2").def(9.81).above(0),
+      choice("buoyancy", {"boussinesq", "ideal_gas"},
+             "air.buoyancy: Boussinesq's force, or eq 7's rest density (the air expands)")
+          .def("boussinesq"),
       number("width", "The box's width and depth, in diameters").def(4.0).at_least(2).at_most(20),
       number("below", "Air below the sphere's centre (the plume's side), in diameters")
           .def(4.0)
@@ -96,7 +100,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
 
   // The sphere of the conductor, so the air's temperature is T_s at its surface (as the cavity's walls).
   Json doc = convection_scene("validation/air-sphere", {2 * half_w, 2 * half_w, below + above},
-                              {"-x", "+x", "-y", "+y", "-z", "+z"}, g, dx, settings, Tinf, beta, true, prm);
+                              {"-x", "+x", "-y", "+y", "-z", "+z"}, g, dx, settings, Tinf, beta,
+                              prm["buoyancy"].get<std::string>(), prm);
   doc["air"]["face_exchange_time"] = prm["face_exchange_time"];
   doc["solids"] = {{{"shape", "sphere"},
                     {"material", "conductor"},

@@ -101,8 +101,8 @@ Json air_insulator(const Json& params) {
 }
 
 Json convection_scene(const std::string& name, const Eigen::Vector3d& max, const Json& walls, double g,
-                      double dx, const Json& solver, double temperature, double beta, bool buoyant,
-                      const Json& params) {
+                      double dx, const Json& solver, double temperature, double beta,
+                      const std::string& buoyancy, const Json& params) {
   return {
       {"name", name},
       {"domain",
@@ -126,7 +126,7 @@ Json convection_scene(const std::string& name, const Eigen::Vector3d& max, const
       {"air",
        {{"material", "air"},
         {"temperature", temperature},
-        {"buoyancy", buoyant ? "boussinesq" : "none"},
+        {"buoyancy", buoyancy},
         {"reference_temperature", temperature},
         {"expansion", beta}}},
       {"solids", Json::array()},

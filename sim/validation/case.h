@@ -70,12 +70,12 @@ Json air_material(const Json& params);
 // An adiabatic solid with the air's density and specific heat (walls that pass no heat, sim/kernels/heat.cl).
 Json air_insulator(const Json& params);
 // The scene a natural-convection case starts from: the box [0, max] of air at `temperature` (also the
-// ambient and, with expansion beta, the Boussinesq reference; buoyancy "none" unless `buoyant`), the
-// given walls of air_insulator, gravity -g along z, and a material "conductor" that conducts like the air,
-// so that held solids made of it put the air beside them at their temperature. No solids yet.
+// ambient and the reference of `buoyancy` (air.buoyancy: boussinesq with expansion beta, ideal_gas or none),
+// the given walls of air_insulator, gravity -g along z, and a material "conductor" that conducts like the
+// air, so that held solids made of it put the air beside them at their temperature. No solids yet.
 Json convection_scene(const std::string& name, const Eigen::Vector3d& max, const Json& walls, double g,
-                      double dx, const Json& solver, double temperature, double beta, bool buoyant,
-                      const Json& params);
+                      double dx, const Json& solver, double temperature, double beta,
+                      const std::string& buoyancy, const Json& params);
 
 // solver_schema() with some defaults changed, for a case that needs other solver defaults.
 Field solver_schema_with(const std::vector<std::pair<std::string, Json>>& defaults);

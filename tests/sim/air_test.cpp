@@ -10,6 +10,7 @@
 
 #include "sim/emitters.h"
 #include "sim/error.h"
+#include "sim/fluid_stage.h"
 #include "sim/metrics.h"
 #include "sim/solver.h"
 #include "sim/state_file.h"
@@ -171,6 +172,32 @@ TEST(AirScene, ErrorsNameTheirPath) {
   EXPECT_EQ(error_path(doc), "solids[0].hold_temperature");
   doc["materials"]["air"]["adiabatic"] = true;
   EXPECT_EQ(error_path(doc), "materials.air.adiabatic");
+}
+
+// Eq 7 (air.buoyancy ideal_gas): every air particle's rest density follows its temperature, which the
+// pressure solve's rest-volume form holds; WCSPH has one rest density and is refused by name, and a theta
+// that puts eq 7's pole among the scene's temperatures too.
+TEST(AirScene, IdealGasAirIsMultiphaseAndNamesWhatItNeeds) {
+  Json doc = air_box();
+  doc["air"]["buoyancy"] = "ideal_gas";
+  doc["solver"] = {{"pressure", "dfsph"}};
+  const Scene scene = scene_from_json(doc);
+  EXPECT_EQ(scene.air.buoyancy, Buoyancy::IdealGas);
+  EXPECT_DOUBLE_EQ(scene.air.theta, 1.0 / 273.15);
+  EXPECT_TRUE(scene.multiphase());
+  EXPECT_FALSE(scene.several_rest_densities());
+  EXPECT_EQ(scene.rest_density_split(), 0.0);  // one fluid: nothing is the light one
+  EXPECT_NEAR(ideal_gas_rest_density(1.2, scene.air, 30.0), 1.2, 1e-12);  // T0 defaults to its temperature
+  EXPECT_NEAR(ideal_gas_rest_density(1.2, scene.air, 60.0), 1.2 * 303.15 / 333.15, 1e-12);
+  // Sealed in, air alone may expand and contract: only two fluids of several densities need an open side.
+  doc["domain"]["walls"] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  EXPECT_NO_THROW(scene_from_json(doc));
+  doc["solver"] = {{"pressure", "wcsph"}};
+  EXPECT_EQ(error_path(doc), "air.buoyancy");
+  doc["solver"] = {{"pressure", "dfsph"}};
+  doc["air"]["theta"] = 0.01;
+  doc["air"]["temperature"] = -95.0;
+  EXPECT_EQ(error_path(doc), "air.theta");
 }
 
 class AirTest : public ClSuite {};
@@ -408,6 +435,12 @@ TEST_F(AirTest, CavityMatchesDeVahlDavisAtRa1e3) {
   expect_case_passes(run_validation(cl(), "cavity", 20, {"rayleigh=1e3"}));
 }
 
+// The same cavity with eq 7's ideal-gas air (air.buoyancy ideal_gas): the rest density follows the
+// temperature, 3 % across the cavity, against the same Boussinesq benchmark (Nu within 0.1 % measured).
+TEST_F(AirTest, IdealGasCavityMatchesDeVahlDavisAtRa1e3) {
+  expect_case_passes(run_validation(cl(), "cavity", 20, {"rayleigh=1e3", "buoyancy=ideal_gas"}));
+}
+
 // Air over water at the real density ratio, in a tank open to the room, stays still and flat (issue 18's
 // gate, 1e-3 sqrt(g H)); about 45 s on 2 cores at res 20 (below it the pressure solve's 0.1 % tolerance
 // leaves the water moving faster, as it does with one density).
@@ -643,6 +676,76 @@ TEST_F(AirTest, AirLeavesThroughOpenSidesAndTheRoomsAirComesIn) {
   EXPECT_GT(room, int(n0 / 2));
   const Metrics mt = measure(s);
   EXPECT_LT(std::abs(mt.closure()), 1e-9 * mt.enthalpy_scale) << "closure " << mt.closure() << " J";
+}
+
+// Eq 7 against Charles's law: a 1 cm layer of air under the ceiling of a closed box, sampled at 20 °C (its
+// reference, so it starts at rest on the lattice), warmed evenly to 60 °C by the faces' relaxation
+// (air.face_exchange_time, reaching the whole layer). Lifted by its buoyancy, it spreads downward into the
+// empty half below as the pressure solve gives it the rest volume eq 7 asks: a depth of
+// h (1 + theta T) / (1 + theta T0), within 2 %. Boussinesq air, incompressible at its reference density,
+// keeps its depth. Without heat, ideal-gas air at 60 °C is sampled at eq 7's density and stays.
+TEST_F(AirTest, IdealGasAirTakesTheVolumeCharlesLawGives) {
+  const double dx = 0.001, T = 60.0, T0 = 20.0, depth = 0.01;
+  struct Run {
+    const char* buoyancy;
+    bool heat;
+  };
+  for (const Run run : {Run{"ideal_gas", true}, Run{"boussinesq", true}, Run{"ideal_gas", false}}) {
+    SCOPED_TRACE(std::string(run.buoyancy) + (run.heat ? " warmed" : " without heat"));
+    Json doc = {{"name", "air layer"},
+                {"domain",
+                 {{"min", {0, 0, 0}},
+                  {"max", {0.01, 0.01, 0.02}},
+                  {"walls", {"-x", "+x", "-y", "+y", "-z", "+z"}},
+                  {"wall_material", "insulator"}}},
+                {"spacing", dx},
+                {"materials", materials()},
+                {"ambient", {{"temperature", T}}},
+                {"air",
+                 {{"material", "air"},
+                  {"region", box(0, 0, 0.02 - depth, 0.01, 0.01, 0.02)},
+                  {"temperature", run.heat ? T0 : T},
+                  {"reference_temperature", T0},
+                  {"buoyancy", run.buoyancy},
+                  {"face_exchange_time", 0.03},
+                  {"face_exchange_depth", 0.02}}},
+                {"solver", {{"pressure", "dfsph"}, {"max_dt", 0.001}}},
+                {"heat", {{"enabled", run.heat}}}};
+    doc["materials"]["insulator"] = {{"kind", "solid"},
+                                     {"density", 1.2},
+                                     {"conductivity", 0.0},
+                                     {"specific_heat", 1006.0},
+                                     {"adiabatic", true}};
+    const Scene scene = scene_from_json(doc);
+    Solver s(cl(), scene, initial_state(scene));
+    const double theta = scene.air.theta, ideal = (1 + theta * T) / (1 + theta * T0);
+    const bool expands = run.heat && std::string(run.buoyancy) == "ideal_gas";
+    // The fill weighs eq 7's density at its temperature.
+    EXPECT_NEAR(
+        s.particles().mass(Phase::Air),
+        1000 * 1.2 * dx * dx * dx / (std::string(run.buoyancy) == "ideal_gas" && !run.heat ? ideal : 1.0),
+        1e-6 * 1.2 * 1e-6);
+    while (s.time() < 0.4) s.step();
+    // A layer's mean depth below the ceiling is half its depth, whatever its particles' spacing.
+    const HostParticles p = s.particles();
+    double sum = 0, temperature = 0;
+    int count = 0;
+    const std::vector<float> Ts = temperatures_of(p, scene);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.phase[i] != kAir) continue;
+      ASSERT_TRUE(std::isfinite(p.position[i][2]));
+      sum += 0.02 - double(p.position[i][2]);
+      temperature += Ts.empty() ? T : double(Ts[i]);  // without heat: the fill's
+      ++count;
+    }
+    ASSERT_EQ(count, 1000);
+    const double measured = 2.0 * sum / count, expected = expands ? depth * ideal : depth;
+    std::printf("[ info ] %s%s: air at %.2f °C, depth %.4f mm, expected %.4f mm after %llu steps\n",
+                run.buoyancy, run.heat ? " warmed" : " without heat", temperature / count, 1e3 * measured,
+                1e3 * expected, static_cast<unsigned long long>(s.steps()));
+    EXPECT_NEAR(temperature / count, T, 0.1);
+    EXPECT_NEAR(measured, expected, 0.02 * expected);
+  }
 }
 
 // Still air under an open top stays: the sites along it keep their air, so almost none comes in.
