@@ -232,9 +232,15 @@ int cmd_run(int argc, char** argv) {
           "%.4g, held %.4g, outflow %.4g, inflow %.4g), energy closure %.3g J\n",
           m.ice_mass, m.water_mass, range, b.heat_in(), b.ambient, b.lamps, b.dryers, b.walls, b.held,
           -b.outflow, b.inflow, m.closure());
-      if (m.count[static_cast<int>(Phase::Air)])
-        std::printf("air: %.6g kg, temperature %.4g..%.4g °C (mean %.4g)\n", m.air_mass,
-                    m.air_min_temperature, m.air_max_temperature, m.air_mean_temperature);
+      if (m.count[static_cast<int>(Phase::Air)]) {
+        // Ideal-gas air that fills a closed domain: the pressure its warming or cooling gave the domain.
+        char pressure[80] = "";
+        if (m.pressure_solve.contains("closed_air_pressure_ratio"))
+          std::snprintf(pressure, sizeof pressure, ", pressure %.5g of the room's (closed domain)",
+                        m.pressure_solve["closed_air_pressure_ratio"].get<double>());
+        std::printf("air: %.6g kg, temperature %.4g..%.4g °C (mean %.4g)%s\n", m.air_mass,
+                    m.air_min_temperature, m.air_max_temperature, m.air_mean_temperature, pressure);
+      }
     }
     if (!m.pressure_solve.is_null()) {
       const Json& d = m.pressure_solve;

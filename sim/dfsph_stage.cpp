@@ -54,6 +54,16 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
       {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph_columns.h", "dfsph.cl"},
       relaxation.str());
   k_columns_ = cl::Kernel(program, "dfsph_columns");
+  // A closed domain's air cannot leave as it warms: the domain's pressure rises instead, so that eq 7's
+  // density at that pressure, P / (R T), keeps the air's volume (the thermodynamic pressure of a closed
+  // low-Mach flow, Paolucci 1982). Without it the warming air's rest volumes outgrew the box, which the
+  // solve cannot relieve: warm-plate-air blew up after 2.1 s. Air that fills only part of the domain
+  // (air.region) has room to expand into and stays at the room's pressure.
+  const bool fills =
+      scene.has_air() && scene.air.region.min == scene.domain.min && scene.air.region.max == scene.domain.max;
+  closed_gas_ = ideal_gas_ && scene.open_faces == 0 && fills;
+  lattice_volume_ = std::pow(scene.spacing, 3);
+  if (closed_gas_) k_gas_volume_ = cl::Kernel(program, "dfsph_gas_volume");
   k_error_ = cl::Kernel(program, "dfsph_error");
   k_warm_ = cl::Kernel(program, "dfsph_warm");
   k_correct_ = cl::Kernel(program, "dfsph_correct");
@@ -89,10 +99,33 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
 
 void DfsphStage::mark_fluid() {
   if (layout_.n == 0) return;
+  if (closed_gas_) gas_volume_factor_ = closed_gas_volume_factor();
   set_args(k_columns_, store_[f_.position], store_[f_.phase], store_[f_.material], flow_, col_,
            layout_.stride, static_cast<cl_uint>(layout_.n));
-  if (ideal_gas_) k_columns_.setArg(7, store_[enthalpy_]);
+  if (ideal_gas_) {
+    k_columns_.setArg(7, store_[enthalpy_]);
+    k_columns_.setArg(8, static_cast<float>(gas_volume_factor_));
+  }
   launch(cl_.queue(), k_columns_, layout_.n);
+}
+
+double DfsphStage::closed_gas_volume_factor() {
+  const cl_uint tiles = layout_.ntiles;
+  if (tiles == 0) return 1.0;
+  auto& q = cl_.queue();
+  set_args(k_gas_volume_, store_[f_.position], store_[f_.material], flow_, store_[enthalpy_], sums_,
+           static_cast<cl_uint>(layout_.n), layout_.tile);
+  launch(q, k_gas_volume_, tiles);
+  std::vector<cl_float2> s(tiles);
+  q.enqueueReadBuffer(sums_, CL_TRUE, 0, tiles * 8, s.data());
+  double volume = 0, count = 0;
+  for (const auto& t : s) {
+    volume += t.s[0];
+    count += t.s[1];
+  }
+  // Each particle of air was laid on the lattice at its rest density (rest_density_at): one lattice
+  // volume each, whatever has come and gone since.
+  return volume > 0 ? count * lattice_volume_ / volume : 1.0;
 }
 
 double DfsphStage::mean_error(double rest_density) {

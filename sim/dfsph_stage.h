@@ -72,12 +72,19 @@ class DfsphStage {
   const PressureSolve& last_density() const { return last_density_; }
   const PressureSolve& last_divergence() const { return last_divergence_; }
   const PressureSolveTotals& totals() const { return totals_; }
+  // Ideal-gas air that fills a closed domain (air.buoyancy ideal_gas, no open side, no air.region): the
+  // room's pressure over the domain's, by which the last mark_fluid() scaled the air's rest volumes
+  // (Gay-Lussac's law: (1 + theta T0) / (1 + theta T) for air warmed evenly to T); 1 otherwise.
+  double gas_volume_factor() const { return gas_volume_factor_; }
+  bool closed_gas() const { return closed_gas_; }
 
  private:
   // Runs one solve: warm start, then error / correct sweeps until the mean error is within tolerance
   // (after at least two sweeps) or the cap.
   PressureSolve solve(const NeighbourView& nv, double dt, bool density_mode);
   double mean_error(double rest_density);
+  // count dx^3 / sum_i m_i / rho0(T_i) over the ideal-gas air (dfsph_gas_volume).
+  double closed_gas_volume_factor();
 
   ClRuntime& cl_;
   ParticleStore& store_;
@@ -97,6 +104,12 @@ class DfsphStage {
   bool divergence_warm_start_ = false;  // solver.divergence_warm_start
   bool ideal_gas_ = false;              // THAW_IDEAL_GAS: the columns read the enthalpy (eq 7)
   ParticleStore::Field enthalpy_ = 0;
+  // Ideal-gas air that fills a domain without open sides: its rest volumes are scaled so that together
+  // they keep one lattice volume per particle (the domain's pressure rises as its air warms).
+  bool closed_gas_ = false;
+  double lattice_volume_ = 0;  // dx^3
+  double gas_volume_factor_ = 1.0;
+  cl::Kernel k_gas_volume_;
   bool extrapolate_ = true;  // solver.boundary_pressure adami2012; akinci2012 leaves the boundary's kappa 0
   cl::Buffer col_, sums_;
   PressureSolve last_density_, last_divergence_;

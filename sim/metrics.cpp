@@ -102,13 +102,16 @@ Json pressure_solve_json(const Solver& s) {
     return Json{{"iterations", p.iterations}, {"error", p.error}, {"tolerance", tolerance}, {"converged", p.converged}};
   };
   const SolverSettings& st = s.scene().solver;
-  return {{"density", solve(d->last_density(), st.density_tolerance)},
-          {"divergence", solve(d->last_divergence(), st.divergence_tolerance)},
-          {"mean_density_iterations", double(t.density_iterations) / steps},
-          {"mean_divergence_iterations", double(t.divergence_iterations) / steps},
-          {"unconverged_density_steps", t.density_unconverged},
-          {"unconverged_divergence_steps", t.divergence_unconverged},
-          {"worst_unconverged_density_error", t.worst_density_error}};
+  Json out = {{"density", solve(d->last_density(), st.density_tolerance)},
+              {"divergence", solve(d->last_divergence(), st.divergence_tolerance)},
+              {"mean_density_iterations", double(t.density_iterations) / steps},
+              {"mean_divergence_iterations", double(t.divergence_iterations) / steps},
+              {"unconverged_density_steps", t.density_unconverged},
+              {"unconverged_divergence_steps", t.divergence_unconverged},
+              {"worst_unconverged_density_error", t.worst_density_error}};
+  // Ideal-gas air filling a closed domain: its pressure over the room's (Gay-Lussac's law).
+  if (d->closed_gas()) out["closed_air_pressure_ratio"] = 1.0 / d->gas_volume_factor();
+  return out;
 }
 
 Json bodies_json(const Solver& s) {

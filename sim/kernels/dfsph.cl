@@ -90,11 +90,38 @@
 
 /* FM: who is fluid, as the lanes of the other passes (and the density pass's alpha) read it; run after the
  * grid's sort, before the density pass. */
+#ifdef THAW_IDEAL_GAS
+/* Eq 7's rest density of particle i at its temperature (theta > 0: ideal-gas air; fluid_params.h), before
+ * the closed domain's pressure factor (dfsph_gas_volume). */
+float ideal_gas_rest_density(global const MaterialFlow* flow, const uchar m, const float2 h) {
+  const float T = (h.x + h.y) * flow[m].inv_specific_heat;
+  return flow[m].rest_density * (1.0f + flow[m].theta * flow[m].reference_temperature) /
+         fmax(1.0f + flow[m].theta * T, 0.1f);
+}
+
+/* Per tile: the rest volume sum_i m_i / rho0(T_i) of the ideal-gas air at the room's pressure, and its
+ * particle count (deterministic, unlike atomics); sim/dfsph_stage.cpp makes the closed domain's pressure
+ * factor of it. */
+kernel void dfsph_gas_volume(global const float4* pos, global const uchar* material, global const MaterialFlow* flow,
+                             global const float2* enthalpy, global float2* sums, const uint n, const uint tile) {
+  const uint t = get_global_id(0);
+  if (t >= (n + tile - 1) / tile) return;
+  const uint b = t * tile, e = min(b + tile, n);
+  float volume = 0.0f, count = 0.0f;
+  for (uint i = b; i < e; ++i) {
+    if (!(flow[material[i]].theta > 0.0f)) continue;
+    volume += pos[i].w / ideal_gas_rest_density(flow, material[i], enthalpy[i]);
+    count += 1.0f;
+  }
+  sums[t] = (float2)(volume, count);
+}
+#endif
+
 kernel void dfsph_columns(global const float4* pos, global const uchar* phase, global const uchar* material,
                           global const MaterialFlow* flow, global float* col, const uint stride, const uint n
 #ifdef THAW_IDEAL_GAS
                           ,
-                          global const float2* enthalpy
+                          global const float2* enthalpy, const float gas_volume_factor
 #endif
 ) {
   const uint i = get_global_id(0);
@@ -106,13 +133,11 @@ kernel void dfsph_columns(global const float4* pos, global const uchar* phase, g
    * T0 (fluid_params.h; theta 0 for every material but ideal-gas air). The constraint Σ V_j W_ij = 1 then
    * makes room for warm air's larger rest volume (the expansion Boussinesq leaves out), and the pressure
    * moves it by 1/rho0_i (dfsph_correct: its inertia); its weight less the reference air's is the forces
-   * pass's (fluid_stage.cpp). Written here, after the sort, so every pass of the step reads one V. */
-  const float theta = flow[material[i]].theta;
-  if (theta > 0.0f) {
-    const float2 h = enthalpy[i];
-    const float T = (h.x + h.y) * flow[material[i]].inv_specific_heat;
-    rho0 *= (1.0f + theta * flow[material[i]].reference_temperature) / fmax(1.0f + theta * T, 0.1f);
-  }
+   * pass's (fluid_stage.cpp). In a closed domain every volume is scaled by gas_volume_factor, the room's
+   * pressure over the domain's (dfsph_gas_volume; 1 where a side is open). Written here, after the sort,
+   * so every pass of the step reads one V. */
+  if (flow[material[i]].theta > 0.0f)
+    rho0 = ideal_gas_rest_density(flow, material[i], enthalpy[i]) / gas_volume_factor;
 #endif
   const float v = pos[i].w / rho0;
   col[COL_VOL * stride + i] = v;

@@ -745,7 +745,68 @@ TEST_F(AirTest, IdealGasAirTakesTheVolumeCharlesLawGives) {
                 1e3 * expected, static_cast<unsigned long long>(s.steps()));
     EXPECT_NEAR(temperature / count, T, 0.1);
     EXPECT_NEAR(measured, expected, 0.02 * expected);
+    // A layer (air.region) has room to expand: it stays at the room's pressure.
+    EXPECT_FALSE(measure(s).pressure_solve.contains("closed_air_pressure_ratio"));
   }
+}
+
+// Gay-Lussac's law: air that fills a closed box cannot expand as it warms, so the box's pressure rises
+// instead (the thermodynamic pressure of a closed low-Mach flow): warmed evenly from 20 to 60 °C by the
+// faces' relaxation, the air's rest volumes keep the box's volume, scaled by the room's pressure over the
+// box's, (1 + theta T0) / (1 + theta T) within 0.5 %, and the air stays where it was, none clamped.
+// Unscaled, the warming air's volume outgrew the box and the solve blew up (warm-plate-air after 2.1 s).
+TEST_F(AirTest, IdealGasAirSealedInABoxKeepsItsVolumeAsItsPressureRises) {
+  const double T = 60.0, T0 = 20.0;
+  Json doc = {{"name", "sealed air"},
+              {"domain",
+               {{"min", {0, 0, 0}},
+                {"max", {0.01, 0.01, 0.01}},
+                {"walls", {"-x", "+x", "-y", "+y", "-z", "+z"}},
+                {"wall_material", "insulator"}}},
+              {"spacing", 0.001},
+              {"materials", materials()},
+              {"ambient", {{"temperature", T}}},
+              {"air",
+               {{"material", "air"},
+                {"temperature", T0},
+                {"buoyancy", "ideal_gas"},
+                {"face_exchange_time", 0.03},
+                {"face_exchange_depth", 0.01}}},
+              {"solver", {{"pressure", "dfsph"}, {"max_dt", 0.001}}}};
+  doc["materials"]["insulator"] = {{"kind", "solid"},
+                                   {"density", 1.2},
+                                   {"conductivity", 0.0},
+                                   {"specific_heat", 1006.0},
+                                   {"adiabatic", true}};
+  const Scene scene = scene_from_json(doc);
+  Solver s(cl(), scene, initial_state(scene));
+  const HostParticles p0 = s.particles();
+  while (s.time() < 0.4) s.step();
+  const HostParticles p = s.particles();
+  const std::vector<float> Ts = temperatures_of(p, scene);
+  double mean_T = 0, mean_z = 0, mean_z0 = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.phase[i] != kAir) continue;
+    ASSERT_TRUE(std::isfinite(p.position[i][2]));
+    mean_T += Ts[i] / 1000.0;
+    mean_z += p.position[i][2] / 1000.0;
+  }
+  for (std::size_t i = 0; i < p0.size(); ++i)
+    if (p0.phase[i] == kAir) mean_z0 += p0.position[i][2] / 1000.0;
+  const double theta = scene.air.theta, expected = (1 + theta * T0) / (1 + theta * mean_T);
+  ASSERT_NE(s.dfsph(), nullptr);
+  std::printf(
+      "[ info ] air at %.2f °C, volume factor %.5f (expected %.5f), mean height %.4f mm (at the start "
+      "%.4f mm), %llu clamped\n",
+      mean_T, s.dfsph()->gas_volume_factor(), expected, 1e3 * mean_z, 1e3 * mean_z0,
+      static_cast<unsigned long long>(s.clamped()));
+  EXPECT_NEAR(mean_T, T, 0.1);
+  EXPECT_NEAR(s.dfsph()->gas_volume_factor(), expected, 0.005 * expected);
+  // The metrics (and the protocol's stats) carry it as the box's pressure over the room's.
+  EXPECT_NEAR(measure(s).pressure_solve.value("closed_air_pressure_ratio", 0.0),
+              1.0 / s.dfsph()->gas_volume_factor(), 1e-12);
+  EXPECT_NEAR(mean_z, mean_z0, 0.05 * scene.spacing);
+  EXPECT_EQ(s.clamped(), 0u);
 }
 
 // Still air under an open top stays: the sites along it keep their air, so almost none comes in.
