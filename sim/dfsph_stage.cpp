@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "sim/cl_launch.h"
@@ -109,31 +110,10 @@ void DfsphStage::mark_fluid() {
   launch(cl_.queue(), k_columns_, layout_.n);
 }
 
-double DfsphStage::closed_gas_volume_factor() {
-  const cl_uint tiles = layout_.ntiles;
-  if (tiles == 0) return 1.0;
-  auto& q = cl_.queue();
-  set_args(k_gas_volume_, store_[f_.position], store_[f_.material], flow_, store_[enthalpy_], sums_,
-           static_cast<cl_uint>(layout_.n), layout_.tile);
-  launch(q, k_gas_volume_, tiles);
-  std::vector<cl_float2> s(tiles);
-  q.enqueueReadBuffer(sums_, CL_TRUE, 0, tiles * 8, s.data());
-  double volume = 0, count = 0;
-  for (const auto& t : s) {
-    volume += t.s[0];
-    count += t.s[1];
-  }
-  // Each particle of air was laid on the lattice at its rest density (rest_density_at): one lattice
-  // volume each, whatever has come and gone since.
-  return volume > 0 ? count * lattice_volume_ / volume : 1.0;
-}
-
-double DfsphStage::mean_error(double rest_density) {
+std::pair<double, double> DfsphStage::tile_sums(cl::Kernel& k) {
   auto& q = cl_.queue();
   const cl_uint tiles = layout_.ntiles;
-  if (tiles == 0) return 0.0;
-  set_args(k_sum_, col_, store_[f_.phase], sums_, layout_.stride, static_cast<cl_uint>(layout_.n), layout_.tile);
-  launch(q, k_sum_, tiles);
+  launch(q, k, tiles);
   std::vector<cl_float2> s(tiles);
   q.enqueueReadBuffer(sums_, CL_TRUE, 0, tiles * 8, s.data());
   double sum = 0, count = 0;
@@ -141,6 +121,23 @@ double DfsphStage::mean_error(double rest_density) {
     sum += t.s[0];
     count += t.s[1];
   }
+  return {sum, count};
+}
+
+double DfsphStage::closed_gas_volume_factor() {
+  if (layout_.ntiles == 0) return 1.0;
+  set_args(k_gas_volume_, store_[f_.position], store_[f_.material], flow_, store_[enthalpy_], sums_,
+           static_cast<cl_uint>(layout_.n), layout_.tile);
+  const auto [volume, count] = tile_sums(k_gas_volume_);
+  // Each particle of air was laid on the lattice at its rest density (rest_density_at): one lattice
+  // volume each, whatever has come and gone since.
+  return volume > 0 ? count * lattice_volume_ / volume : 1.0;
+}
+
+double DfsphStage::mean_error(double rest_density) {
+  if (layout_.ntiles == 0) return 0.0;
+  set_args(k_sum_, col_, store_[f_.phase], sums_, layout_.stride, static_cast<cl_uint>(layout_.n), layout_.tile);
+  const auto [sum, count] = tile_sums(k_sum_);
   return count > 0 ? sum / count / rest_density : 0.0;
 }
 

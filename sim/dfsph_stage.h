@@ -11,6 +11,7 @@
 #include <CL/opencl.hpp>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "sim/cl_runtime.h"
 #include "sim/particle_store.h"
@@ -85,6 +86,8 @@ class DfsphStage {
   double mean_error(double rest_density);
   // count dx^3 / sum_i m_i / rho0(T_i) over the ideal-gas air (dfsph_gas_volume).
   double closed_gas_volume_factor();
+  // Runs a per-tile sum kernel (its arguments set, writing sums_) and adds its (sum, count) pairs up.
+  std::pair<double, double> tile_sums(cl::Kernel& k);
 
   ClRuntime& cl_;
   ParticleStore& store_;

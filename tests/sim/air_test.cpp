@@ -678,6 +678,37 @@ TEST_F(AirTest, AirLeavesThroughOpenSidesAndTheRoomsAirComesIn) {
   EXPECT_LT(std::abs(mt.closure()), 1e-9 * mt.enthalpy_scale) << "closure " << mt.closure() << " J";
 }
 
+// A closed box [0, 1 cm]^2 x [0, height] of adiabatic walls at 1 mm, with ambient.temperature `ambient`,
+// holding ideal-gas (or other `buoyancy`) air at `temperature` (reference 20 °C) in `region` (the whole
+// box if null), whose faces' relaxation (30 ms) reaches all of it: air warmed evenly toward the ambient.
+Json warming_air_box(double height, const Json& region, double temperature, double ambient,
+                     const std::string& buoyancy) {
+  Json doc = {{"name", "warming air"},
+              {"domain",
+               {{"min", {0, 0, 0}},
+                {"max", {0.01, 0.01, height}},
+                {"walls", {"-x", "+x", "-y", "+y", "-z", "+z"}},
+                {"wall_material", "insulator"}}},
+              {"spacing", 0.001},
+              {"materials", materials()},
+              {"ambient", {{"temperature", ambient}}},
+              {"air",
+               {{"material", "air"},
+                {"temperature", temperature},
+                {"reference_temperature", 20.0},
+                {"buoyancy", buoyancy},
+                {"face_exchange_time", 0.03},
+                {"face_exchange_depth", height}}},
+              {"solver", {{"pressure", "dfsph"}, {"max_dt", 0.001}}}};
+  if (!region.is_null()) doc["air"]["region"] = region;
+  doc["materials"]["insulator"] = {{"kind", "solid"},
+                                   {"density", 1.2},
+                                   {"conductivity", 0.0},
+                                   {"specific_heat", 1006.0},
+                                   {"adiabatic", true}};
+  return doc;
+}
+
 // Eq 7 against Charles's law: a 1 cm layer of air under the ceiling of a closed box, sampled at 20 °C (its
 // reference, so it starts at rest on the lattice), warmed evenly to 60 °C by the faces' relaxation
 // (air.face_exchange_time, reaching the whole layer). Lifted by its buoyancy, it spreads downward into the
@@ -692,30 +723,9 @@ TEST_F(AirTest, IdealGasAirTakesTheVolumeCharlesLawGives) {
   };
   for (const Run run : {Run{"ideal_gas", true}, Run{"boussinesq", true}, Run{"ideal_gas", false}}) {
     SCOPED_TRACE(std::string(run.buoyancy) + (run.heat ? " warmed" : " without heat"));
-    Json doc = {{"name", "air layer"},
-                {"domain",
-                 {{"min", {0, 0, 0}},
-                  {"max", {0.01, 0.01, 0.02}},
-                  {"walls", {"-x", "+x", "-y", "+y", "-z", "+z"}},
-                  {"wall_material", "insulator"}}},
-                {"spacing", dx},
-                {"materials", materials()},
-                {"ambient", {{"temperature", T}}},
-                {"air",
-                 {{"material", "air"},
-                  {"region", box(0, 0, 0.02 - depth, 0.01, 0.01, 0.02)},
-                  {"temperature", run.heat ? T0 : T},
-                  {"reference_temperature", T0},
-                  {"buoyancy", run.buoyancy},
-                  {"face_exchange_time", 0.03},
-                  {"face_exchange_depth", 0.02}}},
-                {"solver", {{"pressure", "dfsph"}, {"max_dt", 0.001}}},
-                {"heat", {{"enabled", run.heat}}}};
-    doc["materials"]["insulator"] = {{"kind", "solid"},
-                                     {"density", 1.2},
-                                     {"conductivity", 0.0},
-                                     {"specific_heat", 1006.0},
-                                     {"adiabatic", true}};
+    Json doc =
+        warming_air_box(0.02, box(0, 0, 0.02 - depth, 0.01, 0.01, 0.02), run.heat ? T0 : T, T, run.buoyancy);
+    doc["heat"] = {{"enabled", run.heat}};
     const Scene scene = scene_from_json(doc);
     Solver s(cl(), scene, initial_state(scene));
     const double theta = scene.air.theta, ideal = (1 + theta * T) / (1 + theta * T0);
@@ -757,27 +767,7 @@ TEST_F(AirTest, IdealGasAirTakesTheVolumeCharlesLawGives) {
 // Unscaled, the warming air's volume outgrew the box and the solve blew up (warm-plate-air after 2.1 s).
 TEST_F(AirTest, IdealGasAirSealedInABoxKeepsItsVolumeAsItsPressureRises) {
   const double T = 60.0, T0 = 20.0;
-  Json doc = {{"name", "sealed air"},
-              {"domain",
-               {{"min", {0, 0, 0}},
-                {"max", {0.01, 0.01, 0.01}},
-                {"walls", {"-x", "+x", "-y", "+y", "-z", "+z"}},
-                {"wall_material", "insulator"}}},
-              {"spacing", 0.001},
-              {"materials", materials()},
-              {"ambient", {{"temperature", T}}},
-              {"air",
-               {{"material", "air"},
-                {"temperature", T0},
-                {"buoyancy", "ideal_gas"},
-                {"face_exchange_time", 0.03},
-                {"face_exchange_depth", 0.01}}},
-              {"solver", {{"pressure", "dfsph"}, {"max_dt", 0.001}}}};
-  doc["materials"]["insulator"] = {{"kind", "solid"},
-                                   {"density", 1.2},
-                                   {"conductivity", 0.0},
-                                   {"specific_heat", 1006.0},
-                                   {"adiabatic", true}};
+  const Json doc = warming_air_box(0.01, nullptr, T0, T, "ideal_gas");
   const Scene scene = scene_from_json(doc);
   Solver s(cl(), scene, initial_state(scene));
   const HostParticles p0 = s.particles();
