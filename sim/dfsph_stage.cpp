@@ -60,8 +60,7 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   // low-Mach flow, Paolucci 1982). Without it the warming air's rest volumes outgrew the box, which the
   // solve cannot relieve: warm-plate-air blew up after 2.1 s. Air that fills only part of the domain
   // (air.region) has room to expand into and stays at the room's pressure.
-  const bool fills =
-      scene.has_air() && scene.air.region.min == scene.domain.min && scene.air.region.max == scene.domain.max;
+  const bool fills = scene.air.region.min == scene.domain.min && scene.air.region.max == scene.domain.max;
   closed_gas_ = ideal_gas_ && scene.open_faces == 0 && fills;
   lattice_volume_ = std::pow(scene.spacing, 3);
   if (closed_gas_) k_gas_volume_ = cl::Kernel(program, "dfsph_gas_volume");

@@ -765,7 +765,8 @@ std::vector<std::string> Solver::stages() const {
   // A newcomer sees which form holds air beside water (the same solve, other passes).
   if (dfsph_)
     out.push_back(scene_.multiphase()
-                      ? std::string("pressure (dfsph, multiphase ") + name(scene_.solver.multiphase) + ")"
+                      ? std::string("pressure (dfsph, multiphase ") + name(scene_.solver.multiphase) +
+                            (scene_.air.buoyancy == Buoyancy::IdealGas ? ", eq 7's ideal-gas air)" : ")")
                       : std::string("pressure (dfsph)"));
   if (rigid_) out.push_back("rigid ice");
   out.push_back("time step");

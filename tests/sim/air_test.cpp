@@ -189,6 +189,11 @@ TEST(AirScene, IdealGasAirIsMultiphaseAndNamesWhatItNeeds) {
   EXPECT_EQ(scene.rest_density_split(), 0.0);  // one fluid: nothing is the light one
   EXPECT_NEAR(ideal_gas_rest_density(1.2, scene.air, 30.0), 1.2, 1e-12);  // T0 defaults to its temperature
   EXPECT_NEAR(ideal_gas_rest_density(1.2, scene.air, 60.0), 1.2 * 303.15 / 333.15, 1e-12);
+  EXPECT_NEAR(rest_density_at(scene, scene.air.material, 60.0), 1.2 * 303.15 / 333.15, 1e-12);
+  // Without heat every air particle keeps the fill's rest density, a dryer's warmer air too.
+  Json cold = doc;
+  cold["heat"] = {{"enabled", false}};
+  EXPECT_NEAR(rest_density_at(scene_from_json(cold), scene.air.material, 60.0), 1.2, 1e-12);
   // Sealed in, air alone may expand and contract: only two fluids of several densities need an open side.
   doc["domain"]["walls"] = {"-x", "+x", "-y", "+y", "-z", "+z"};
   EXPECT_NO_THROW(scene_from_json(doc));
@@ -728,6 +733,10 @@ TEST_F(AirTest, IdealGasAirTakesTheVolumeCharlesLawGives) {
     doc["heat"] = {{"enabled", run.heat}};
     const Scene scene = scene_from_json(doc);
     Solver s(cl(), scene, initial_state(scene));
+    const std::vector<std::string> stages = s.stages();
+    EXPECT_EQ(std::find(stages.begin(), stages.end(),
+                        "pressure (dfsph, multiphase hu_adams2006, eq 7's ideal-gas air)") != stages.end(),
+              std::string(run.buoyancy) == "ideal_gas");
     const double theta = scene.air.theta, ideal = (1 + theta * T) / (1 + theta * T0);
     const bool expands = run.heat && std::string(run.buoyancy) == "ideal_gas";
     // The fill weighs eq 7's density at its temperature.
