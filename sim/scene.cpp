@@ -922,7 +922,9 @@ double ideal_gas_rest_density(double material_density, const AirFill& air, doubl
 double rest_density_at(const Scene& scene, int material, double temperature) {
   const double rho = scene.materials.at(static_cast<std::size_t>(material)).density;
   // Without heat every air particle keeps the rest density of the fill's temperature (the flow table's
-  // row, material_flow_table): a dryer's warmer air too, so that it starts on the lattice as well.
+  // row, material_flow_table): a dryer's warmer air too, so that it starts on the lattice as well. With
+  // heat enabled the heat stage is built wherever a new particle's temperature differs (plan_heat counts
+  // the dryers' and the room's air), so its temperature is the one the flow table reads.
   if (scene.has_air() && material == scene.air.material && scene.air.buoyancy == Buoyancy::IdealGas)
     return ideal_gas_rest_density(rho, scene.air, scene.heat.enabled ? temperature : scene.air.temperature);
   return rho;

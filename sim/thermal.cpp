@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "sim/emitters.h"
 #include "sim/solver.h"
 
 namespace thaw {
@@ -137,6 +138,10 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
   for (const Emitter& e : scene.emitters) T.push_back(static_cast<float>(e.temperature));
   for (const Dryer& d : scene.dryers)
     if (d.model == DryerModel::Air) T.push_back(static_cast<float>(d.temperature));
+  // So does the room's air that open sides let in, at the ambient temperature (sim/emitters.h). Left out,
+  // air at 25 °C beside a 20 °C room built no heat, and the room's air came in at 20 °C's mass
+  // (rest_density_at) into a flow table that holds 25 °C's rest density for every air particle.
+  if (EmitterStage::admits_room_air(scene)) T.push_back(static_cast<float>(scene.heat.ambient_temperature));
   const auto [lo, hi] = std::minmax_element(T.begin(), T.end());
   const bool spread = !T.empty() && double(*hi) - double(*lo) > kSame;
   auto differs = [&](double outside) {

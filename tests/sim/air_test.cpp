@@ -104,6 +104,29 @@ TEST(AirScene, AirParticlesSwitchTheAmbientModelOff) {
   EXPECT_TRUE(plan_heat(without, initial_state(without).particles).ambient);
 }
 
+// The room's air that an open side lets in counts among the temperatures: air at 25 °C beside a 20 °C
+// room builds heat (so the new air's eq 7 density is the one the solve reads); beside a 25 °C room, none.
+TEST(AirScene, TheRoomsAirAtAnotherTemperatureBuildsHeat) {
+  Json doc = air_box();
+  doc["solids"] = Json::array();
+  doc["domain"]["walls"] = Json::array();  // walls start at the ambient temperature: the air is all there is
+  doc["domain"]["open"] = {"+z"};
+  doc["air"]["temperature"] = 25.0;
+  doc["ambient"] = {{"temperature", 20.0}};
+  const Scene warmer = scene_from_json(doc);
+  const HeatPlan a = plan_heat(warmer, initial_state(warmer).particles);
+  EXPECT_TRUE(a.build);
+  EXPECT_NE(a.reason.find("temperatures range from 20 to 25"), std::string::npos) << a.reason;
+  doc["ambient"]["temperature"] = 25.0;
+  const Scene same = scene_from_json(doc);
+  EXPECT_FALSE(plan_heat(same, initial_state(same).particles).build);
+  doc["domain"].erase("open");  // closed: no room air comes in
+  doc["ambient"]["temperature"] = 20.0;
+  const Scene closed = scene_from_json(doc);
+  const HeatPlan c = plan_heat(closed, initial_state(closed).particles);
+  EXPECT_FALSE(c.build) << c.reason;
+}
+
 // The adiabatic pass is built where a solid or the walls are adiabatic, not where such a material is only
 // declared.
 TEST(AirScene, TheAdiabaticPassIsPlannedOnlyForAnAdiabaticSolidInUse) {
