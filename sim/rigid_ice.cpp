@@ -84,8 +84,9 @@ RigidIce::RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build
       settings_(std::move(settings)),
       anchored_by_id_(std::move(anchored_by_id)),
       mass_scale_(std::move(mass_scale)) {
-  const auto program =
-      cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "rigid.cl"}, build_options);
+  const auto program = cl.build(
+      {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph_columns.h", "rigid.cl"},
+      build_options);
   k_forces_ = cl::Kernel(program, "rigid_forces");
   k_place_ = cl::Kernel(program, "rigid_place");
   labeller_ = std::make_unique<IceLabeller>(cl, settings_.grid_reach);
@@ -225,9 +226,11 @@ void RigidIce::compute_forces(const ParticleBuffers& p) {
            p.grid, static_cast<float>(settings_.support), 0.01f * h * h,
            static_cast<float>(settings_.visc_boundary), static_cast<float>(settings_.rest_density), contact,
            force_, p.n);
-  if (flow_) {  // multiphase builds (rigid.cl): each fluid neighbour's rest density
+  if (flow_) {  // multiphase builds (rigid.cl): each fluid neighbour's rest volume and density
     k_forces_.setArg(15, p.material);
     k_forces_.setArg(16, *flow_);
+    k_forces_.setArg(17, *columns_);
+    k_forces_.setArg(18, columns_stride_);
   }
   launch(cl_.queue(), k_forces_, p.n);
 }

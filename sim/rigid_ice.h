@@ -92,9 +92,14 @@ class RigidIce {
   void relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool force = false);
   // After the density pass: the force on each ice particle of a free body.
   void compute_forces(const ParticleBuffers& p);
-  // Multiphase builds (THAW_MULTIPHASE): the fluid passes' material table, whose rest densities the
-  // forces from fluid of several densities need (sim/kernels/rigid.cl).
-  void use_flow_table(const cl::Buffer& flow) { flow_ = &flow; }
+  // Multiphase builds (THAW_MULTIPHASE): the fluid passes' material table and the DFSPH solve's columns
+  // (blocks of `stride` floats), whose rest volumes the forces from fluid of several densities need
+  // (sim/kernels/rigid.cl). Both must outlive this.
+  void use_multiphase(const cl::Buffer& flow, const cl::Buffer& columns, std::uint32_t stride) {
+    flow_ = &flow;
+    columns_ = &columns;
+    columns_stride_ = stride;
+  }
   // The fastest point of any free body [m/s] (the time step's CFL limit covers it).
   double max_point_speed() const;
   // Sums the forces per body, integrates the bodies over dt and moves their particles.
@@ -137,7 +142,9 @@ class RigidIce {
   cl::Kernel k_forces_, k_place_;
   ParticleStore::Field body_ = 0, offset_ = 0;
   cl::Buffer force_, label_, bodies_dev_, refs_;
-  const cl::Buffer* flow_ = nullptr;  // use_flow_table
+  const cl::Buffer* flow_ = nullptr;  // use_multiphase
+  const cl::Buffer* columns_ = nullptr;
+  std::uint32_t columns_stride_ = 0;
   std::size_t bodies_capacity_ = 0;
   std::vector<IceBody> bodies_;
   std::vector<std::vector<Eigen::Vector3f>> shapes_;  // each body's particle offsets in its own frame

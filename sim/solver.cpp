@@ -321,7 +321,8 @@ void Solver::build(const SimState& st, std::size_t capacity) {
         std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow(), plan.build);
   if (dfsph_) fluid_->compute_dfsph_alpha(dfsph_->columns(), dfsph_->min_neighbours());
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
-  if (rigid_ && fluid_ && dfsph_ && scene_.multiphase()) rigid_->use_flow_table(fluid_->flow());
+  if (rigid_ && fluid_ && dfsph_ && scene_.multiphase())
+    rigid_->use_multiphase(fluid_->flow(), dfsph_->columns(), layout_.stride);
   forces_velocity_ = rigid_ && dfsph_
                          ? cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, layout_.capacity * sizeof(cl_float4))
                          : cl::Buffer();

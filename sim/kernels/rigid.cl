@@ -42,7 +42,8 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
                          global float4* force, const uint n
 #ifdef THAW_MULTIPHASE
                          ,
-                         global const uchar* material, global const MaterialFlow* flow
+                         global const uchar* material, global const MaterialFlow* flow, global const float* col,
+                         const uint stride
 #endif
 ) {
   const uint i = get_global_id(0);
@@ -71,12 +72,17 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
       const float mj = pos[j].w;
       const float vd = dot(vi.xyz - vel[j].xyz, x);
 #ifdef THAW_MULTIPHASE
-      /* Fluids of several densities (dfsph.cl, forces.cl): pressure -V_b V_j (p_b + p_j) grad W with rest
-       * volumes V_b = Psi_b / rho0, V_j = m_j / rho0_j, and the boundary's viscosity at the fluid's own
-       * density; the sum is multiplied by m_b = Psi_b below. */
-      const float rho0_j = flow[material[j]].rest_density;
-      const float s = visc_boundary * mj * (rho0_j / (rho_i * sj.x)) * vd / (r2 + eps2) -
-                      (mj / (rho0_j * rho0)) * (si.w + sj.w);
+      /* Fluids of several densities: the reaction of dfsph_correct's pressure -V_b V_j (p_b + p_j) grad W,
+       * with the solve's rest volume V_j (column VOL: eq 7's, by temperature, for ideal-gas air; not the
+       * material row's) and V_b = Psi_b / rho0; the light fluid (air) pushed with its own pressure for the
+       * boundary's (dfsph_correct's mirror, p_b = p_j), the heavy one with the boundary's. The viscosity is
+       * forces.cl's boundary pair, at the material row's density as that pass takes it. The sum is
+       * multiplied by m_b = Psi_b below. */
+      const float vol_j = col[COL_VOL * stride + j];
+      const float pb = mj < THAW_MP_SPLIT * vol_j ? sj.w : si.w; /* rho0_j = m_j / V_j */
+      const float rho0_row = flow[material[j]].rest_density;
+      const float s = visc_boundary * mj * (rho0_row / (rho_i * sj.x)) * vd / (r2 + eps2) -
+                      (vol_j / rho0) * (pb + sj.w);
 #else
       const float s = visc_boundary * mj * (rho0 / (rho_i * sj.x)) * vd / (r2 + eps2) - mj * (dpi + sj.y);
 #endif
