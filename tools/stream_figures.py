@@ -4,6 +4,10 @@ time from sending a dryer command to the arrival of the first frame drawn from t
 which the command took effect (its ack says when) or later.
 
     tools/stream_figures.py ws://127.0.0.1:8080/ [--fast] [--scale S] [--fps F] [--tries N]
+
+With --melt F it instead watches as one viewer until the scene's ice has lost the fraction F of its mass
+(the stats' ice_fraction, from the moment it connects), or for --limit seconds, and prints the frames per
+second it received, the simulated seconds per wall second meanwhile and the wall time the melt took.
 """
 import argparse
 import asyncio
@@ -57,6 +61,29 @@ async def main(url, fast, tries, settings):
           "simulation %.0f steps/s" % statistics.mean(r[1] for r in rates))
     print("10 viewers: dryer command to frame: " + summary(timed))
 
+async def melt(url, fraction, limit, settings):
+    """One viewer until ice_fraction falls by `fraction`: frames/s, simulated s per wall s, wall time."""
+    async with thaw_client.connect(url) as thaw:
+        if settings:
+            await thaw.command("quality.set", **settings)
+        await thaw.frame()
+        s0 = await thaw.stats(lambda s: s.get("ice_fraction") is not None)
+        t0, frames, s1 = time.monotonic(), 0, s0
+        while s1["ice_fraction"] > s0["ice_fraction"] - fraction and time.monotonic() - t0 < limit:
+            await thaw.frame()
+            frames += 1
+            s1 = thaw.latest_stats or s1
+        wall = time.monotonic() - t0
+        melted = s0["ice_fraction"] - s1["ice_fraction"]
+        print("1 viewer: %.1f frames/s; %.4f simulated s per wall s (%.1f wall s per simulated s), %.0f steps/s" %
+              (frames / wall, (s1["time"] - s0["time"]) / wall, wall / max(s1["time"] - s0["time"], 1e-12),
+               (s1["steps"] - s0["steps"]) / wall))
+        print("ice fraction %.4f -> %.4f (%.1f %% of the start lost) in %.1f s of wall time, %.4f -> %.4f s "
+              "simulated%s" % (s0["ice_fraction"], s1["ice_fraction"], 100 * melted, wall, s0["time"], s1["time"],
+                               "" if melted >= fraction else "; stopped at --limit before the melt"))
+        return melted >= fraction
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("url", help="ws://HOST:PORT/ of a running thaw serve")
@@ -64,6 +91,12 @@ if __name__ == "__main__":
     parser.add_argument("--tries", type=int, default=10, help="dryer commands timed per case")
     parser.add_argument("--fps", type=float, help="ask for this frame rate cap first")
     parser.add_argument("--scale", type=float, help="ask for this fraction of width and height marched first")
+    parser.add_argument("--melt", type=float, help="watch until the ice has lost this fraction of its mass")
+    parser.add_argument("--limit", type=float, default=1800, help="longest wall time to watch with --melt [s]")
     args = parser.parse_args()
     settings = {k: v for k, v in (("fps", args.fps), ("scale", args.scale)) if v}
+    if args.melt:
+        if args.fast:
+            settings["surface"] = "fast"
+        sys.exit(0 if asyncio.run(melt(args.url, args.melt, args.limit, settings)) else 1)
     asyncio.run(main(args.url, args.fast, args.tries, settings))

@@ -853,11 +853,12 @@ TEST_F(AirTest, StillAirUnderAnOpenTopStays) {
   EXPECT_EQ(s.clamped(), 0u);
 }
 
-// The shipped scenes with air particles (issue 18's ice-in-warm-air, ice-half-submerged, icicles-air-dryer):
-// each builds the multiphase solve (ice melts into water beside air), runs 20 steps with its energy books
-// closed and no particle lost, and the dryer's box keeps its air as it blows.
+// The shipped scenes with air particles (issue 18's ice-in-warm-air, ice-half-submerged, icicles-air-dryer,
+// and the interactive ice-air-dryer): each builds the multiphase solve (ice melts into water beside air),
+// runs 20 steps with its energy books closed and no particle lost, and the dryer's box keeps its air as it
+// blows.
 TEST_F(AirTest, TheShippedAirScenesRunWithClosedBooks) {
-  for (const char* name : {"ice-in-warm-air", "ice-half-submerged", "icicles-air-dryer"}) {
+  for (const char* name : {"ice-in-warm-air", "ice-half-submerged", "icicles-air-dryer", "ice-air-dryer"}) {
     SCOPED_TRACE(name);
     const Scene scene = load_scene(name);
     ASSERT_TRUE(scene.has_air());
