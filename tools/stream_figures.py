@@ -67,7 +67,10 @@ async def melt(url, fraction, limit, settings):
         if settings:
             await thaw.command("quality.set", **settings)
         await thaw.frame()
-        s0 = await thaw.stats(lambda s: s.get("ice_fraction") is not None)
+        s0 = await thaw.stats()
+        if s0.get("ice_fraction") is None:
+            print("--melt: scene '%s' has no ice to melt" % s0.get("scene"))
+            return False
         t0, frames, s1 = time.monotonic(), 0, s0
         while s1["ice_fraction"] > s0["ice_fraction"] - fraction and time.monotonic() - t0 < limit:
             await thaw.frame()
