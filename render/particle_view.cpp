@@ -32,7 +32,9 @@ Image background(int w, int h) {
   return img;
 }
 
-// The temperature scale: the given one, else the range over ice and water (all particles without any).
+// The temperature scale: the given one, else the range over ice, water and air (all particles without
+// any). Air counts so that a dryer's warm jet shows beside the ice it melts: over ice and water alone, a
+// scene's 22 to 70 °C air all took the top colour (the scale -4 to 0 °C in ice-air-dryer's slice).
 void temperature_range(const RenderSnapshot& s, double& lo, double& hi) {
   if (lo < hi) return;
   if (s.temperature.empty()) throw Error("colouring by temperature needs a scene with heat");
@@ -41,7 +43,7 @@ void temperature_range(const RenderSnapshot& s, double& lo, double& hi) {
   for (int pass = 0; pass < 2 && !(lo <= hi); ++pass)
     for (std::size_t i = 0; i < s.temperature.size(); ++i) {
       const auto ph = static_cast<Phase>(s.phase[i]);
-      if (pass == 0 && ph != Phase::Water && ph != Phase::Ice) continue;
+      if (pass == 0 && ph != Phase::Water && ph != Phase::Ice && ph != Phase::Air) continue;
       lo = std::min(lo, double(s.temperature[i]));
       hi = std::max(hi, double(s.temperature[i]));
     }

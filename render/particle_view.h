@@ -20,8 +20,8 @@ void check_colouring(const std::string& value, const std::string& what);
 
 struct ParticleViewOptions {
   std::string colour_by = "phase";  // "phase" | "temperature" | "speed"
-  // The scale [°C or m/s]; t_min == t_max: the particles' own range (for speed 0 to the fastest water or
-  // air particle).
+  // The scale [°C or m/s]; t_min == t_max: the particles' own range (temperature over ice, water and air;
+  // for speed 0 to the fastest water or air particle).
   double t_min = 0, t_max = 0;
   bool solids = true;  // draw static solids (walls, plates); glass only when coloured by phase
 };

@@ -67,6 +67,23 @@ TEST(ParticleView, TemperatureColoursMapAKnownHotAndColdParticleToTheColourBarEn
   EXPECT_LT(chroma(cold).dot(chroma(hot)), 0.9) << "the two ends differ";
 }
 
+// The scale spans the air too (issue 18: the views show the warm jet), not the solids: ice at -5 °C, a
+// dryer's air at 70 °C and a heater at 300 °C give -5 to 70 °C.
+TEST(ParticleView, TheTemperatureScaleSpansIceWaterAndAirButNotSolids) {
+  RenderSnapshot s = two_particles(-5.0f, 0.0f);
+  s.position.push_back({0.0f, 0.0f, 0.05f});
+  s.phase.push_back(static_cast<std::uint8_t>(Phase::Air));
+  s.temperature.push_back(70.0f);
+  s.position.push_back({0.0f, 0.0f, -0.05f});
+  s.phase.push_back(static_cast<std::uint8_t>(Phase::Solid));
+  s.temperature.push_back(300.0f);
+  ParticleViewOptions o;
+  o.colour_by = "temperature";
+  const ViewImage v = render_particles(s, front_camera(), o);
+  EXPECT_DOUBLE_EQ(v.t_min, -5.0);
+  EXPECT_DOUBLE_EQ(v.t_max, 70.0);
+}
+
 TEST(ParticleView, PhaseColoursTellIceFromWater) {
   const RenderSnapshot s = two_particles(0.0f, 0.0f);
   const OrbitCamera cam = front_camera();
