@@ -90,7 +90,7 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   density_tolerance_ = scene.solver.density_tolerance;
   divergence_tolerance_ = scene.solver.divergence_tolerance;
   max_iterations_ = scene.solver.max_pressure_iterations;
-  const int columns = kColumns + (scene.multiphase() ? 1 : 0);
+  const int columns = kColumns + (scene.multiphase() ? 2 : 0);  // VOL and RHO
   col_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::size_t(layout.stride) * columns * 4);
   // Lanes read up to 15 floats past the last particle: keep the padding finite.
   cl.queue().enqueueFillBuffer(col_, 0.0f, 0, std::size_t(layout.stride) * columns * 4);

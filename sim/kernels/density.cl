@@ -53,6 +53,8 @@ kernel void density(global const float4* pos, global const float* soa, global co
   floatV count = (floatV)(0.0f);
 #ifdef THAW_MULTIPHASE
   floatV hx = (floatV)(0.0f), hy = (floatV)(0.0f), hz = (floatV)(0.0f);
+  floatV light = (floatV)(0.0f); /* sum_light V_j W_ij, for a heavy particle's COL_RHO */
+  const int heavy = rho0 >= THAW_MP_SPLIT;
 #endif
 #endif
 #ifdef THAW_NO_SLIP
@@ -81,7 +83,8 @@ kernel void density(global const float4* pos, global const float* soa, global co
       const floatV m = vloadV(0, M + j);
 #endif
       const floatV q = sqrt(r2) * inv_H;
-      acc += select((floatV)(0.0f), m * w_shape(q), in);
+      const floatV mw = m * w_shape(q);
+      acc += select((floatV)(0.0f), mw, in);
 #ifdef THAW_NO_SLIP
       if (boundary) {
         const intV ph = THAW_CAT(convert_int, THAW_VW)(THAW_CAT(vload, THAW_VW)(0, phase + j));
@@ -116,6 +119,8 @@ kernel void density(global const float4* pos, global const float* soa, global co
         hx += select((floatV)(0.0f), cw * mg * dx, in);
         hy += select((floatV)(0.0f), cw * mg * dy, in);
         hz += select((floatV)(0.0f), cw * mg * dz, in);
+        if (heavy) /* a light neighbour: rho0_j = V_j / FM_j below the split */
+          light += select((floatV)(0.0f), mw, in & (fm > 0.0f) & (fm * THAW_MP_SPLIT > m));
         s += select((floatV)(0.0f), cw * fm * gf * gf * r2, in);
 #else
         s += select((floatV)(0.0f), fm * gf * gf * r2, in);
@@ -170,6 +175,10 @@ kernel void density(global const float4* pos, global const float* soa, global co
     col[COL_AD * stride + i] = alpha;
     col[COL_AV * stride + i] = lanes_sum(count) - 1.0f >= (float)min_neighbours ? alpha : 0.0f; /* -1: itself */
   }
+#ifdef THAW_MULTIPHASE
+  /* Boundary particles too: ice that melts this step is fluid in the density solve. */
+  col[COL_RHO * stride + i] = rho - rho0 * THAW_SIGMA(H) * lanes_sum(light);
+#endif
 #endif
 #ifdef THAW_DFSPH
   /* DFSPH (sim/kernels/dfsph.cl) solves for the pressure after the forces pass: none here. */

@@ -150,44 +150,42 @@ kernel void dfsph_columns(global const float4* pos, global const uchar* phase, g
 
 /* Σ_j m_j (v_i - v_j)·∇W_ij over every neighbour (boundary particles move with their body or not at all).
  * Multiphase builds: Σ_j V_j (v_i - v_j)·∇W_ij, and with `heavy` (a water particle) over its heavy and
- * boundary neighbours only, with Σ_j V_j W_ij over its light (air) neighbours in y, which dfsph_error takes
- * out of its number density: water's constraint leaves the air out, as at a free surface. Counted in (the
+ * boundary neighbours only; its density (COL_RHO, from the density pass) likewise leaves its light (air)
+ * neighbours' share out: water's constraint leaves the air out, as at a free surface. Counted in (the
  * number-density form's own choice), air pressed against water raised the water's density, whose pressure
  * moves only water (the pair weight c_ij is 2 rho0_air / (rho0_w + rho0_air) on it at the interface): a
  * 1.2 cm drop in an 8 m/s jet flung its surface particles off at 6 m/s within a few milliseconds, and the
  * jet lifted free ice cubes out of a glass of water. The air still counts the water in its own constraint,
  * and its pressure pushes the water at the interface (dfsph_correct). */
-float2 density_rate(const float4 pi, const float3 vi, global const float* soa, global const float* col,
-                    global const uint* cell_start, const Grid g, const float H, const uint stride, const int heavy) {
+float density_rate(const float4 pi, const float3 vi, global const float* soa, global const float* col,
+                   global const uint* cell_start, const Grid g, const float H, const uint stride, const int heavy) {
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
   DFSPH_SOA(soa, stride)
   global const float* VX = soa + 4 * stride;
   global const float* VY = soa + 5 * stride;
   global const float* VZ = soa + 6 * stride;
-  floatV acc = (floatV)(0.0f), light = (floatV)(0.0f);
+  floatV acc = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
       DFSPH_LANES(pr, j, je, H2)
       const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
                         (vi.z - vloadV(0, VZ + j)) * dz;
-      const floatV q = sqrt(r2) * inv_H;
 #ifdef THAW_MULTIPHASE
       const floatV vj = vloadV(0, col + COL_VOL * stride + j);
       intV skip = (intV)(0);
-      if (heavy) { /* the air's rows (most of them) read no more than before */
+      if (heavy) { /* the air's rows (most of them) read no more than one fluid's */
         const floatV fmj = vloadV(0, col + COL_FM * stride + j);
         skip = (fmj > 0.0f) & (fmj * THAW_MP_SPLIT > vj); /* rho0_j = V_j / FM_j < split */
-        light += select((floatV)(0.0f), vj * w_shape(q), in & skip);
       }
-      acc += select((floatV)(0.0f), vj * grad_shape(q) * vd, in & ~skip);
+      acc += select((floatV)(0.0f), vj * grad_shape(sqrt(r2) * inv_H) * vd, in & ~skip);
 #else
-      acc += select((floatV)(0.0f), vloadV(0, M + j) * grad_shape(q) * vd, in);
+      acc += select((floatV)(0.0f), vloadV(0, M + j) * grad_shape(sqrt(r2) * inv_H) * vd, in);
 #endif
     }
   }
-  return (float2)(THAW_SIGMA(H) * inv_H * inv_H * lanes_sum(acc), THAW_SIGMA(H) * lanes_sum(light));
+  return THAW_SIGMA(H) * inv_H * inv_H * lanes_sum(acc);
 }
 
 /* One Jacobi sweep's first half: each fluid particle's error and κ, from the velocities as they are.
@@ -202,12 +200,11 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
   const float4 pi = pos[i];
   const float3 vi = (float3)(soa[4 * stride + i], soa[5 * stride + i], soa[6 * stride + i]);
 #ifdef THAW_MULTIPHASE
-  const float vol_i = col[COL_VOL * stride + i];
-  const float2 r = density_rate(pi, vi, soa, col, cell_start, g, H, stride, pi.w > THAW_MP_SPLIT * vol_i);
-  const float rate = r.x;
-  const float rho = density[i] - r.y * pi.w / vol_i; /* less rho0_i Σ_light V_j W_ij (water's, above) */
+  const int heavy = pi.w > THAW_MP_SPLIT * col[COL_VOL * stride + i];
+  const float rate = density_rate(pi, vi, soa, col, cell_start, g, H, stride, heavy);
+  const float rho = col[COL_RHO * stride + i]; /* water's without the air's share (density_rate) */
 #else
-  const float rate = density_rate(pi, vi, soa, col, cell_start, g, H, stride, 0).x;
+  const float rate = density_rate(pi, vi, soa, col, cell_start, g, H, stride, 0);
   const float rho = density[i];
 #endif
   float err, k;
