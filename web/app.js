@@ -223,11 +223,16 @@ function onStats(m) {
   if (m.ice_fraction !== null && m.ice_fraction !== undefined)
     lines.push(`ice ${(1000 * m.ice_mass).toFixed(2)} g (${(100 * m.ice_fraction).toFixed(1)} % of the start)`);
   if (T) lines.push(`T mean ${T.mean.toFixed(2)} °C, ${T.min.toFixed(1)} to ${T.max.toFixed(1)} °C`);
-  lines.push(
-    `particles ${m.particles.water} water, ${m.particles.ice} ice   ` +
-      (m.inflow ? `poured ${(1000 * m.inflow.mass).toFixed(1)} g   ` : '') +
-      (m.outflow ? `ran out ${(1000 * m.outflow.mass).toFixed(1)} g   ` : '') +
-      (m.energy ? `energy closure ${m.energy.closure_relative.toExponential(1)}` : ''));
+  // With air particles, what comes in and goes out is mostly air (a dryer's jet and its intake, the room's
+  // air at open sides), not water poured and run out.
+  const A = m.air_temperature, air = m.particles.air || 0;
+  if (A) lines.push(`air mean ${A.mean.toFixed(1)} °C, ${A.min.toFixed(1)} to ${A.max.toFixed(1)} °C`);
+  lines.push(`particles ${m.particles.water} water, ${m.particles.ice} ice` + (air ? `, ${air} air` : ''));
+  // The books on a line of their own: with the air's count the line outgrew the picture.
+  const books = (m.inflow ? `${air ? 'came in' : 'poured'} ${(1000 * m.inflow.mass).toFixed(1)} g   ` : '') +
+      (m.outflow ? `${air ? 'went out' : 'ran out'} ${(1000 * m.outflow.mass).toFixed(1)} g   ` : '') +
+      (m.energy ? `energy closure ${m.energy.closure_relative.toExponential(1)}` : '');
+  if (books) lines.push(books);
   if (m.error) lines.push(`stopped: ${m.error}`);
   hud.textContent = lines.join('\n');
   drawPlot();

@@ -151,6 +151,34 @@ async def scenario(call, js, until):
   EXPECT_TRUE(served.stop()) << served.log();
 }
 
+// An air scene's page (issue 18): the readout says how much air there is and how warm (the dryer's jet
+// shows in the air's top temperature), and calls what comes in and goes out what it is, air, not water
+// poured; the readout's lines stay within the picture.
+TEST(BrowserClient, AnAirScenesReadoutShowsItsAir) {
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
+      << "Debian's chromium is not installed (scripts/setup)";
+  TempDir dir("browser-air");
+  ServedScene served(dir, "ice-air-dryer --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(in_chromium(R"py(
+HUD = "document.getElementById('hud').textContent"
+async def scenario(call, js, until):
+    print("air counted", bool(await until(f"/particles 0 water, 216 ice, 11724 air/.test({HUD})", 60)))
+    warm = await until(f"(() => {{ const m = {HUD}.match(/air mean [-0-9.]+ °C, [-0-9.]+ to ([-0-9.]+) °C/); return m && Number(m[1]) > 40 ? Number(m[1]) : null; }})()", 90)
+    print("[ info ] the air's warmest", warm, "°C")
+    print("jet warm", bool(warm))
+    print("books named", bool(await until(f"/came in [0-9.]+ g/.test({HUD}) && !/poured/.test({HUD})", 60)))
+    fits = await js("(() => { const h = document.getElementById('hud'); return h.scrollWidth <= h.clientWidth + 1 && h.getBoundingClientRect().right <= document.getElementById('view').getBoundingClientRect().right + 1; })()")
+    print("fits", fits)
+)py"),
+                                            240, &status);
+  EXPECT_EQ(status, 0) << out;
+  expect_lines(out, {"connected True", "air counted True", "jet warm True", "books named True", "fits True",
+                     "screenshot True"});
+  EXPECT_TRUE(served.stop()) << served.log();
+}
+
 // A watchable pace (issue 16): in the default scene as it ships, with its dryer on, the ice the page
 // shows loses at least 10 % of its mass within 60 s of wall time (THAW_TEST_TIME_SCALE stretches the
 // limit on a loaded machine), while the water moves; the page says how fast time runs and the heat
