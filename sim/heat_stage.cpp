@@ -30,7 +30,11 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
       layout_(layout) {
   enthalpy_ = store.add({"enthalpy", FieldType::Float32, 2});
 
-  std::string opts = build_options + " -DTHAW_EXPOSED_AREA=" + name(scene.heat.exposed_area);
+  std::string opts = build_options;
+  if (uses_surface())
+    opts += " -DTHAW_SURFACE_AREA";
+  else
+    opts += " -DTHAW_EXPOSED_AREA=iwasaki2010";
   if (plan.ambient) opts += " -DTHAW_AMBIENT";
   if (plan.dryers) opts += " -DTHAW_DRYERS";
   if (plan.walls) opts += " -DTHAW_WALL_HEAT";
@@ -41,7 +45,7 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
     if (scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h",
-                                 "dryer_model.h", "heat_params.h", "heat.cl"},
+                                 "dryer_model.h", "heat_params.h", "wrapped_walk.h", "heat.cl"},
                                 opts);
   k_thermal_state_ = cl::Kernel(program, "thermal_state");
   k_heat_ = cl::Kernel(program, "heat");
@@ -85,6 +89,10 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
 }
 
 HeatStage::~HeatStage() = default;
+
+bool HeatStage::uses_surface() const {
+  return scene_.heat.exposed_area != ExposedArea::Iwasaki2010 && (plan_.ambient || plan_.dryers);
+}
 
 double HeatStage::max_dt() const {
   double dt = std::min(diffusion_dt_, wall_dt_);
@@ -212,7 +220,7 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
   const cl::Buffer& lamp_energy = plan_.lamps ? lamp_energy_ : dryers_;
   set_args(k_heat_, store_[core_.position], store_[core_.velocity], store_[enthalpy_], store_[core_.phase],
            store_[core_.material], materials_, nv.soa, thermal_, nv.cell_start, nv.grid, P, dryers_,
-           lamp_energy, budget_parts_, phase_changed_);
+           lamp_energy, budget_parts_, phase_changed_, uses_surface() ? store_[surface_area_] : dryers_);
   launch(q, k_heat_, layout_.n);
   set_args(k_budget_, budget_parts_, store_[enthalpy_], layout_.stride, budget_tiles_, budget_bad_, n,
            layout_.tile);

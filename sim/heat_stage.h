@@ -35,6 +35,12 @@ class HeatStage {
 
   ParticleStore::Field enthalpy() const { return enthalpy_; }
 
+  // Whether the exchange with the air takes each particle's area from the surface stage (heat.exposed_area
+  // other than iwasaki2010, with ambient exchange or cone dryers); then the solver builds that stage and
+  // hands its "surface_area" field here before the first run.
+  bool uses_surface() const;
+  void surface_from(ParticleStore::Field area) { surface_area_ = area; }
+
   // The stage's limit on dt [s]: diffusion, the tank walls, exchange with the air and the dryers.
   double max_dt() const;
 
@@ -71,7 +77,7 @@ class HeatStage {
   double last_dt_heat_ = 0;  // of the last run() [s]
   float support_ = 0, smoothing_ = 0, rest_density_ = 0;
   const ParticleLayout& layout_;  // the solver's: the particle count changes when water leaves
-  ParticleStore::Field enthalpy_ = 0;
+  ParticleStore::Field enthalpy_ = 0, surface_area_ = 0;
   cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_budget_, k_adiabatic_;
   cl::Buffer materials_, thermal_, lamp_energy_, hits_, budget_parts_, budget_tiles_, budget_bad_, dryers_,
       phase_changed_;

@@ -54,7 +54,17 @@ const char* name(KernelFunction k) {
 const char* name(Eos e) { return e == Eos::Tait ? "tait" : "linear"; }
 const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph" : "wcsph"; }
 const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
-const char* name(ExposedArea) { return "iwasaki2010"; }
+const char* name(ExposedArea a) {
+  switch (a) {
+    case ExposedArea::Orthmann2013:
+      return "orthmann2013";
+    case ExposedArea::Brackbill1992:
+      return "brackbill1992";
+    case ExposedArea::Iwasaki2010:
+      break;
+  }
+  return "iwasaki2010";
+}
 const char* name(DfsphBoundary b) { return b == DfsphBoundary::Akinci2012 ? "akinci2012" : "adami2012"; }
 const char* name(Multiphase m) {
   return m == Multiphase::DomaradzkiMartyn ? "domaradzki_martyn" : "hu_adams2006";
@@ -268,7 +278,9 @@ HeatSettings heat_settings_from_json(const Json& doc) {
   h.enabled = doc["heat"]["enabled"].get<bool>();
   h.time_scale = doc["heat"]["time_scale"].get<double>();
   h.max_substeps = doc["heat"]["max_substeps"].get<int>();
-  h.exposed_area = choice_of<ExposedArea>(doc["heat"]["exposed_area"], {ExposedArea::Iwasaki2010});
+  h.exposed_area = choice_of<ExposedArea>(
+      doc["heat"]["exposed_area"],
+      {ExposedArea::Iwasaki2010, ExposedArea::Orthmann2013, ExposedArea::Brackbill1992});
   h.ambient_temperature = doc["ambient"]["temperature"].get<double>();
   h.ambient_coefficient = doc["ambient"]["heat_transfer_coefficient"].get<double>();
   h.wall_coefficient = doc["domain"]["wall_heat"]["coefficient"].get<double>();

@@ -38,7 +38,7 @@ enum class BoundaryVolume { Lattice, Akinci2012 };
 enum class DfsphBoundary { Adami2012, Akinci2012 };
 // How fluids of several rest densities meet (dfsph, sim/kernels/dfsph.cl).
 enum class Multiphase { HuAdams2006, DomaradzkiMartyn };
-enum class ExposedArea { Iwasaki2010 };
+enum class ExposedArea { Iwasaki2010, Orthmann2013, Brackbill1992 };
 // How walls hold the fluid's tangential velocity: only through boundary_viscosity, or no-slip.
 enum class NoSlip { None, Adami2012 };
 // What a dryer is: an analytic cone of warm air that heats exposed ice and water (scenes without air
@@ -51,7 +51,7 @@ const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
 const char* name(Eos e);             // "tait", "linear"
 const char* name(PressureSolver p);  // "wcsph", "dfsph"
 const char* name(BoundaryVolume b);  // "lattice", "akinci"
-const char* name(ExposedArea a);     // "iwasaki2010" (also the heat pass's function suffix)
+const char* name(ExposedArea a);     // "iwasaki2010", "orthmann2013", "brackbill1992"
 const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
 const char* name(Multiphase m);      // "hu_adams2006", "domaradzki_martyn"
 const char* name(NoSlip n);          // "none", "adami2012"

@@ -314,10 +314,13 @@ const Field& scene_schema() {
                       .def(1)
                       .at_least(1)
                       .at_most(64),
-                  choice("exposed_area", {"iwasaki2010"},
-                         "Model of each particle's surface exposed to air: iwasaki2010 = (6 - n_i) / 6 of a "
-                         "voxel's six faces, n_i the particles within 1.2 spacings (Iwasaki et al. 2010 sec. "
-                         "4)")
+                  choice("exposed_area", {"iwasaki2010", "brackbill1992", "orthmann2013"},
+                         "Model of each particle's surface exposed to air (the surface stage, "
+                         "docs/SURFACE.md): brackbill1992 = the colour gradient's surface delta |grad c| "
+                         "(Brackbill et al. 1992), scaled so a flat face sums to its area, with Orthmann et "
+                         "al. 2013's thin-sheet handling; orthmann2013 = Orthmann et al. 2013 eqs 2-9 as the "
+                         "paper has them; iwasaki2010 = (6 - n_i) / 6 of a voxel's six faces, n_i the "
+                         "particles within 1.2 spacings (Iwasaki et al. 2010 sec. 4)")
                       .def("iwasaki2010"),
               },
               "Heat transfer and phase change (Iwasaki et al. 2010; docs/ARCHITECTURE.md Numerics)."),

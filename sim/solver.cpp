@@ -305,6 +305,8 @@ void Solver::build(const SimState& st, std::size_t capacity) {
 
   // The stages this scene needs, each declaring its fields; then the fields are allocated and filled.
   rigid_.reset();
+  surface_.reset();
+  surface_done_ = false;
   heat_.reset();
   dfsph_.reset();
   fluid_.reset();
@@ -328,6 +330,10 @@ void Solver::build(const SimState& st, std::size_t capacity) {
                          : cl::Buffer();
   if (plan.build)
     heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
+  if (heat_ && heat_->uses_surface()) {
+    surface_ = std::make_unique<SurfaceStage>(cl_, store_, f_, scene_, k_, opts, layout_);
+    heat_->surface_from(surface_->area());
+  }
   if (fluid_ && heat_) fluid_->buoyancy_from(heat_->enthalpy());
   if (dfsph_ && heat_) dfsph_->rest_density_from(heat_->enthalpy());
   store_.allocate(layout_.capacity);
@@ -634,6 +640,10 @@ void Solver::step() {
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
   if (heat_) {
     timed(Stage::Photons, [&] { trace_photons(dt); });
+    if (surface_ && (scene_.solver.flow || !surface_done_)) {
+      timed(Stage::Surface, [&] { surface_->run(neighbours()); });
+      surface_done_ = true;
+    }
     timed(Stage::Heat, [&] { compute_heat(dt); });
   }
   if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
@@ -668,6 +678,10 @@ void Solver::step_dfsph() {
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
   if (heat_) {
     timed(Stage::Photons, [&] { trace_photons(dt); });
+    if (surface_ && (scene_.solver.flow || !surface_done_)) {
+      timed(Stage::Surface, [&] { surface_->run(neighbours()); });
+      surface_done_ = true;
+    }
     timed(Stage::Heat, [&] { compute_heat(dt); });
   }
   timed(Stage::Pressure, [&] {
@@ -710,6 +724,7 @@ void Solver::warm_up() {
   choose_time_step();
   integrate(0.0);
   // dt = 0 adds no heat; the budget's sums of zero leave it unchanged.
+  if (surface_) surface_->run(neighbours());
   if (heat_) heat_->warm_up(neighbours(), budget_);
   cl_.queue().finish();
 }
@@ -774,6 +789,7 @@ std::vector<std::string> Solver::stages() const {
   if (heat_ && heat_->tracing_photons()) out.push_back("photons");
   if (heat_ && !heat_->tracing_photons() && !scene_.lamps.empty())
     out.push_back("photons (when a lamp is on)");
+  if (surface_) out.push_back(std::string("surface (") + name(scene_.heat.exposed_area) + ")");
   if (heat_) out.push_back("heat (" + heat_reason_ + ")");
   if (fluid_) out.push_back("integrate");
   // A scene without taps or dryers has this stage for its open sides: say so.
@@ -803,6 +819,14 @@ double Solver::total_enthalpy() const {
     sum += mass * (double(p.enthalpy[i][0]) + double(p.enthalpy[i][1]));
   }
   return sum;
+}
+
+std::vector<float> Solver::surface_areas() const {
+  std::vector<float> a;
+  if (!surface_ || n_ == 0) return a;
+  a.resize(n_);
+  cl_.queue().enqueueReadBuffer(store_[surface_->area()], CL_TRUE, 0, n_ * 4, a.data());
+  return a;
 }
 
 std::vector<float> Solver::temperatures() const {

@@ -21,6 +21,7 @@
 #include "sim/scene.h"
 #include "sim/stage_timers.h"
 #include "sim/state_file.h"
+#include "sim/surface_stage.h"
 
 namespace thaw {
 
@@ -170,6 +171,9 @@ class Solver {
   std::vector<std::uint32_t> cell_starts() const;
   std::vector<float> densities() const;
   std::vector<Float4> pressure_state() const;  // per particle (rho, p/rho^2, is_boundary, p)
+  // Each particle's surface area [m^2] from the surface stage (sim/surface_stage.h), as the last step left
+  // it; empty when the scene does not build that stage.
+  std::vector<float> surface_areas() const;
   std::vector<float> temperatures() const;     // per particle [°C], from the last heat stage's state
   // The heat stage's inputs as its neighbour loop reads them (for reference loops and tests): T [°C],
   // k [W/m/K] and V [m^3] per particle, from the last compute_heat(); empty without heat.
@@ -229,6 +233,8 @@ class Solver {
   // never changes and stays on the host, by particle id (fixed_enthalpy_). The budget is the run's
   // whatever is built; the thermal table gives the masses its enthalpy sum needs.
   std::unique_ptr<HeatStage> heat_;
+  std::unique_ptr<SurfaceStage> surface_;  // only when heat_ takes its exposed areas from it
+  bool surface_done_ = false;              // without flow the particles never move: one pass serves the run
   std::string heat_reason_;
   std::vector<Float2> fixed_enthalpy_;
   std::vector<thermal::MaterialThermal> table_;

@@ -10,7 +10,8 @@ namespace thaw {
 // IceForces and Bodies run only in scenes with free ice (sim/rigid_ice.h): the forces on ice particles,
 // and labelling, per-body sums, rigid integration and placing the ice particles. Emit runs only in scenes
 // with emitters (sim/emitters.h), and includes growing the capacity. Pressure runs only with DFSPH
-// (sim/dfsph_stage.h): alpha, the divergence and density solves, and the predicted velocities.
+// (sim/dfsph_stage.h): alpha, the divergence and density solves, and the predicted velocities. Surface runs
+// only where the heat stage takes its exposed areas from it (sim/surface_stage.h).
 enum class Stage {
   Grid,
   Density,
@@ -19,6 +20,7 @@ enum class Stage {
   IceForces,
   TimeStep,
   Photons,
+  Surface,
   Heat,
   Bodies,
   Integrate,
@@ -26,7 +28,8 @@ enum class Stage {
   Count
 };
 inline constexpr std::array<const char*, static_cast<int>(Stage::Count)> kStageNames = {
-    "grid", "density", "forces", "pressure", "ice_forces", "time_step", "photons", "heat", "bodies", "integrate", "emit"};
+    "grid",    "density", "forces", "pressure", "ice_forces", "time_step",
+    "photons", "surface", "heat",   "bodies",   "integrate",  "emit"};
 
 class StageTimers {
  public:

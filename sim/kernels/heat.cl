@@ -35,54 +35,6 @@ kernel void thermal_state(global const float4* pos, global const float* density,
   thermal[2 * stride + i] = pos[i].w / rho;
 }
 
-/* Neighbour rows around cell c. Along periodic axes (-DTHAW_PERIODIC_X/Y/Z: any axis in the heat-only mode, y
- * and z in a flowing scene) the grid
- * wraps and cells are visited one at a time, so that a wrapped x range needs no special case. */
-#if defined(THAW_PERIODIC_X) || defined(THAW_PERIODIC_Y) || defined(THAW_PERIODIC_Z)
-#define THAW_PERIODIC 1
-#endif
-
-#ifdef THAW_PERIODIC
-int wrap_axis(int v, int n, int periodic) { return periodic ? (v + n) % n : v; }
-#ifdef THAW_PERIODIC_X
-#define THAW_PX 1
-#else
-#define THAW_PX 0
-#endif
-#ifdef THAW_PERIODIC_Y
-#define THAW_PY 1
-#else
-#define THAW_PY 0
-#endif
-#ifdef THAW_PERIODIC_Z
-#define THAW_PZ 1
-#else
-#define THAW_PZ 0
-#endif
-/* The cell (dz, dy, dx) around c with the periodic axes wrapped, or -1 where it lies outside the grid. */
-int heat_cell(const Grid g, const int4 c, const int dz, const int dy, const int dx) {
-  const int z = wrap_axis(c.z + dz, g.nz, THAW_PZ), y = wrap_axis(c.y + dy, g.ny, THAW_PY),
-            x = wrap_axis(c.x + dx, g.nx, THAW_PX);
-  return (z < 0 || z >= g.nz || y < 0 || y >= g.ny || x < 0 || x >= g.nx) ? -1 : (z * g.ny + y) * g.nx + x;
-}
-/* As FOR_EACH_NEIGHBOUR_ROW (grid_common.h), one cell at a time: the statement that follows sees [jb, je). */
-#define FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je)                                              \
-  for (int dz_ = -1; dz_ <= 1; ++dz_)                                                              \
-    for (int dy_ = -1; dy_ <= 1; ++dy_)                                                            \
-      for (int dx_ = -1; dx_ <= 1; ++dx_)                                                          \
-        for (int cell_ = heat_cell(g, c, dz_, dy_, dx_); cell_ >= 0; cell_ = -1)                   \
-          for (uint jb = (cell_start)[cell_], je = (cell_start)[cell_ + 1], once_ = 1; once_; once_ = 0)
-#else
-#define FOR_EACH_HEAT_RANGE FOR_EACH_NEIGHBOUR_ROW
-#endif
-
-/* Minimum image along periodic axes: period = domain lengths (0 where not periodic). */
-#ifdef THAW_PERIODIC
-#define THAW_WRAP(d, L) ((L) > 0.0f ? (d) - (L) * rint((d) / (L)) : (d))
-#else
-#define THAW_WRAP(d, L) (d)
-#endif
-
 /* The neighbour loops' structure-of-arrays inputs: the reorder's positions and thermal_state's T, k, V. */
 #define HEAT_SOA(soa, thermal, stride)            \
   global const float* X = (soa);                  \
@@ -156,9 +108,9 @@ float2 add_compensated(float2 e, float d) {
   return (float2)(hi, lo - (hi - s));
 }
 
-/* Exposed-area models (heat.exposed_area), chosen at build time with -DTHAW_EXPOSED_AREA=name: the
- * area [m^2] of a particle's surface in contact with air, from the particles that cover it. A surface
- * model that estimates each particle's area (Orthmann et al. 2013) adds its function here. */
+/* Exposed-area models (heat.exposed_area): the area [m^2] of a particle's surface in contact with air.
+ * iwasaki2010 counts the particles that cover it (-DTHAW_EXPOSED_AREA=iwasaki2010); the others are the
+ * surface stage's areas (sim/surface_stage.h), read from `area` with -DTHAW_SURFACE_AREA. */
 float exposed_area_iwasaki2010(int neighbours, float face_area) {
   /* Iwasaki et al. 2010 sec. 4: dA = (6 - n_i) / 6 of the voxel's A = 6 dx^2, clamped at 0. */
   return face_area * (float)max(6 - neighbours, 0);
@@ -183,7 +135,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
                  global uchar* material, global const MaterialThermal* materials, global const float* soa,
                  global const float* thermal, global const uint* cell_start, const Grid g, const HeatParams P,
                  global const DryerJet* dryers, global float* lamp_energy, global float* budget,
-                 global uint* phase_changed) {
+                 global uint* phase_changed, global const float* area) {
   const float H = P.support, eta2 = P.eta2, exposed_r2 = P.exposed_r2, face_area = P.face_area;
   const float ambient_temperature = P.ambient_temperature, ambient_coefficient = P.ambient_coefficient;
   const float dt_heat = P.dt_heat;
@@ -224,7 +176,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
       const floatV term = vloadV(0, VV + j) * kij * (Ti - vloadV(0, TT + j)) * grad_shape(sqrt(r2) * inv_H) *
                           r2 / (r2 + eta2);
       acc += select((floatV)(0.0f), term, in);
-#if defined(THAW_AMBIENT) || defined(THAW_DRYERS)
+#if (defined(THAW_AMBIENT) || defined(THAW_DRYERS)) && !defined(THAW_SURFACE_AREA)
       covered += select((intV)(0), (intV)(1), lane & (r2 < exposed_r2));
 #endif
     }
@@ -232,7 +184,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
   /* x . grad W = sigma / H^2 grad_shape(q) r^2 (sph_lanes.h). */
   const float Vi = VV[i];
   const float q_conduction = 2.0f * Vi * THAW_SIGMA(H) * inv_H * inv_H * lanes_sum(acc);
-#if defined(THAW_AMBIENT) || defined(THAW_DRYERS)
+#if (defined(THAW_AMBIENT) || defined(THAW_DRYERS)) && !defined(THAW_SURFACE_AREA)
   int neighbours = -1; /* the particle itself is in its own range */
   for (int l = 0; l < THAW_VW; ++l) neighbours += ((int*)&covered)[l];
 #endif
@@ -244,7 +196,11 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
    * outside, THAW_LAMPS with lamps), so a scene without them tests no flag per particle. */
   float q_ambient = 0.0f, q_dryers = 0.0f, q_walls = 0.0f;
 #if defined(THAW_AMBIENT) || defined(THAW_DRYERS)
+#ifdef THAW_SURFACE_AREA
+  const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? area[i] : 0.0f;
+#else
   const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? THAW_EXPOSED_FN(neighbours, face_area) : 0.0f;
+#endif
   if (exposed > 0.0f) {
 #ifdef THAW_AMBIENT
     q_ambient = ambient_coefficient * (ambient_temperature - Ti) * exposed;

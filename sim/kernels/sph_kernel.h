@@ -70,6 +70,31 @@ inline double lattice_sum(float (*w)(float, float), double spacing, double suppo
   return sum * spacing * spacing * spacing;
 }
 
+/* Host only: sum over the particles under one dx^2 of a flat face of v |grad c_i|, grad c_i = sum_j v grad
+ * W_ij over a half-space of the simple cubic lattice (its top layer dx/2 below the face, v = dx^3), divided
+ * by dx^2. The continuum gives 1/2 (c falls from 1 to 1/2 inside); the lattice sums to 0.510 for the cubic
+ * spline at H = 2 dx. Its inverse scales brackbill1992's areas (sim/kernels/surface.cl). `grad` is
+ * grad_factor: (dW/dr) / r. */
+inline double flat_face_colour_gradient(float (*grad)(float, float), double spacing, double support) {
+  const auto H = static_cast<float>(support);
+  const int m = static_cast<int>(std::ceil(support / spacing)) + 1;
+  const double v = spacing * spacing * spacing;
+  double total = 0;
+  for (int k = 0; k <= m; ++k) {  // the layer k spacings below the top one
+    double gz = 0;
+    for (int i = -m; i <= m; ++i)
+      for (int j = -m; j <= m; ++j)
+        for (int l = 0; l <= k + m; ++l) {  // neighbours l - k layers below it, within the half-space
+          const int dz = l - k;
+          const double r = spacing * std::sqrt(double(i * i + j * j + dz * dz));
+          if (r == 0 || r >= support) continue;
+          gz += grad(static_cast<float>(r), H) * (-dz * spacing);  // (x_i - x_j).z
+        }
+    total += v * std::abs(v * gz);
+  }
+  return total / (spacing * spacing);
+}
+
 /* Host only: the largest eigenvalue of the Jacobi-preconditioned pressure system D^-1 A of DFSPH's
  * solves (sim/kernels/dfsph.cl) on a resting simple cubic lattice, from its Fourier symbol. A pressure
  * wave pi_j = exp(i k.x_j) changes each particle's density by -dt^2 V^2 / rho0 |s(k)|^2 pi, with

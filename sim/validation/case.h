@@ -56,6 +56,8 @@ ValidationCase cavity_case();
 ValidationCase jet_case();
 ValidationCase air_sphere_case();
 ValidationCase air_water_case();
+ValidationCase surface_area_case();
+ValidationCase ambient_sphere_case();
 
 // Churchill's correlation for natural convection around a sphere: Nu(Ra, Pr) (sim/validation/air_sphere.cpp).
 double churchill_sphere_nusselt(double rayleigh, double prandtl);

@@ -1,0 +1,44 @@
+#pragma once
+// The surface stage: each ice and water particle's share of the surface to the air (or to empty space) it
+// lies under, its outward normal and signed distance (Orthmann et al. 2013 sec. 4, eqs 2-9; the model is
+// heat.exposed_area). Built by the solver only when something reads it: today the heat stage's exchange
+// with the ambient air and the cone dryers (sim/heat_stage.h). Declares "surface_area" [m^2],
+// "surface_normal" (outward normal, phi [m]) and "surface_delta" [1/m], the state eq. 9 relaxes from.
+#include <CL/opencl.hpp>
+#include <string>
+
+#include "sim/cl_runtime.h"
+#include "sim/particle_store.h"
+#include "sim/scene.h"
+#include "sim/stage.h"
+
+namespace thaw {
+
+struct SolverConstants;
+
+class SurfaceStage {
+ public:
+  SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
+               const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout);
+
+  ParticleStore::Field area() const { return area_; }
+  ParticleStore::Field normal() const { return normal_; }
+
+  // The areas, normals and deltas of the particles where they are now.
+  void run(const NeighbourView& nv);
+
+ private:
+  ClRuntime& cl_;
+  ParticleStore& store_;
+  CoreFields core_;
+  const Scene& scene_;
+  const ParticleLayout& layout_;
+  ExposedArea model_;
+  float support_ = 0;
+  double colour_scale_ = 0;
+  double min_neighbours_ = 0;
+  ParticleStore::Field area_ = 0, normal_ = 0, delta_ = 0;
+  cl::Kernel k_delta_, k_area_;
+};
+
+}  // namespace thaw

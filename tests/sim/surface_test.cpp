@@ -1,0 +1,96 @@
+// The surface stage (sim/surface_stage.h): the flat-face scale of brackbill1992, the heat stage's exchange
+// through the stage's areas, and the surface-area case's sphere and sheets at CI resolution.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim/kernels/sph_kernel.h"
+#include "sim/solver.h"
+#include "sim/validation/case.h"
+#include "tests/test_support.h"
+
+namespace thaw {
+namespace {
+
+using testing::ClSuite;
+
+class SurfaceTest : public ClSuite {};
+
+// The continuum's colour falls from 1 to 1/2 inside a flat face, so sum v |grad c| under a face is half its
+// area; the lattice sums come near it (what brackbill1992 divides by).
+TEST(SurfaceScale, AFlatFacesColourGradientSumsNearHalfItsArea) {
+  EXPECT_NEAR(sph::flat_face_colour_gradient(sph::cubic_spline_grad_factor, 1.0, 2.0), 0.510, 0.002);
+  EXPECT_NEAR(sph::flat_face_colour_gradient(sph::wendland_c2_grad_factor, 1.0, 3.0), 0.5, 0.01);
+  // It scales with nothing but the ratio H / dx.
+  EXPECT_NEAR(sph::flat_face_colour_gradient(sph::cubic_spline_grad_factor, 0.004, 0.008),
+              sph::flat_face_colour_gradient(sph::cubic_spline_grad_factor, 1.0, 2.0), 1e-5);
+}
+
+// A 4 x 2.4 x 2.4 cm block of ice at -5 °C in 25 °C air: the ambient's heat in the first step is h (T_a - T)
+// times the stage's summed area times dt, and that area is the block's within the rounding of its edges.
+TEST_F(SurfaceTest, AmbientHeatEntersThroughTheStagesAreas) {
+  const Json base = Json::parse(R"({
+    "name": "surface-test", "domain": {"min": [0, 0, 0], "max": [0.08, 0.04, 0.04]}, "spacing": 0.002,
+    "solver": {"flow": false, "max_dt": 0.05},
+    "ambient": {"temperature": 25, "heat_transfer_coefficient": 50},
+    "materials": {
+      "water": {"kind": "fluid", "density": 1000, "conductivity": 0.56, "specific_heat": 4217},
+      "ice": {"kind": "ice", "density": 917, "conductivity": 2.22, "specific_heat": 2050, "melts_into": "water"}},
+    "ice": [{"material": "ice", "box": {"min": [0.02, 0.008, 0.008], "max": [0.06, 0.032, 0.032]}, "temperature": -5}]
+  })");
+  const double faces = 2 * (0.04 * 0.024 * 2 + 0.024 * 0.024);
+  double heat[2] = {0, 0};
+  for (int model = 0; model < 2; ++model) {
+    Json doc = base;
+    doc["heat"]["exposed_area"] = model == 0 ? "brackbill1992" : "iwasaki2010";
+    const Scene scene = scene_from_json(doc);
+    Solver s(cl(), scene, initial_state(scene));
+    s.warm_up();
+    s.step();
+    heat[model] = s.energy_budget().ambient;
+    if (model == 0) {
+      double area = 0;
+      for (float a : s.surface_areas()) area += a;
+      // 0.892 measured: a particle surface rounds a box's edges over about a kernel support (the surface-area
+      // case's box error falls as 1 / R).
+      EXPECT_NEAR(area / faces, 0.89, 0.03) << "summed area " << area << " m^2";
+      EXPECT_NEAR(heat[0], 50.0 * 30.0 * area * s.dt(), 1e-4 * heat[0]);
+    } else {
+      EXPECT_TRUE(s.surface_areas().empty()) << "iwasaki2010 builds no surface stage";
+    }
+  }
+  // On a box on its own lattice iwasaki2010's voxel faces are the faces themselves: the stage's rounded
+  // edges take less.
+  EXPECT_NEAR(heat[1] / heat[0], 1.12, 0.05);
+}
+
+TEST_F(SurfaceTest, TheSurfaceAreaCasesSphereAndSheetsHoldAtResolution20) {
+  const CaseResult r = run_validation(cl(), "surface-area", 20, {});
+  for (const auto& [key, m] : r.metrics) {
+    if (key == "sphere_area" || key == "sphere_spread" || key == "sheet1_spread" || key == "sheet2_spread") {
+      EXPECT_TRUE(m.passed()) << key << " " << m.value << " error " << m.error;
+    }
+    // A sheet one particle thick: 2 dx^2 a particle, both faces exactly; its rim (4 L dx of 2 L^2 + 4 L dx)
+    // is not counted.
+    if (key == "sheet1_area") {
+      EXPECT_NEAR(m.value, 40.0 / 42.0, 1e-4);
+    }
+  }
+}
+
+// The melting sphere with its meltwater drained, over the first half spacing of melt (res 10): the stage's
+// area carries the air's heat within 5 % (3.4 % measured), Iwasaki's neighbour count half again too much.
+TEST_F(SurfaceTest, AnIceSphereInWarmAirMeltsAtTheRateItsAreaSets) {
+  double error[2] = {0, 0};
+  const char* models[2] = {"model=brackbill1992", "model=iwasaki2010"};
+  for (int k = 0; k < 2; ++k) {
+    const CaseResult r = run_validation(cl(), "ambient-sphere", 10, {models[k], "radius_loss=0.05"});
+    for (const auto& [key, m] : r.metrics)
+      if (key == "melted_mass") error[k] = (m.value - m.reference) / m.reference;
+  }
+  EXPECT_LT(std::abs(error[0]), 0.05) << "brackbill1992";
+  EXPECT_GT(error[1], 0.3) << "iwasaki2010";
+}
+
+}  // namespace
+}  // namespace thaw
