@@ -57,15 +57,24 @@ SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields
       for (int c = -m; c <= m; ++c)
         if (scene.spacing * std::sqrt(double(a * a + b * b + c * c)) < k.support) ++count;
   min_neighbours_ = kSingularShare * count;
+  // A neighbourhood with 0.9 of a resting lattice's colour lacks too few particles to be sparse or flat.
+  full_colour_ =
+      0.9 * sph::lattice_sum(wendland ? sph::wendland_c2_w : sph::cubic_spline_w, scene.spacing, k.support);
 
   std::string opts = build_options;
   opts += model_ == ExposedArea::Orthmann2013 ? " -DTHAW_AREA_ORTHMANN2013" : " -DTHAW_AREA_BRACKBILL1992";
   for (int a = 0; a < 3; ++a)
     if (scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
-  const auto program =
-      cl.build({"sph_kernel.h", "grid_common.h", "wrapped_walk.h", "surface_params.h", "surface.cl"}, opts);
+  const auto program = cl.build(
+      {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h", "surface_params.h", "surface.cl"},
+      opts);
+  k_inside_ = cl::Kernel(program, "surface_inside");
   k_delta_ = cl::Kernel(program, "surface_delta");
+  const std::size_t padded = std::size_t(layout.stride) * 4;
+  inside_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
+  delta_lanes_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
+  cl.queue().enqueueFillBuffer(delta_lanes_, 0.0f, 0, padded);
   if (model_ == ExposedArea::Orthmann2013) k_area_ = cl::Kernel(program, "surface_area");
 }
 
@@ -85,14 +94,17 @@ void SurfaceStage::run(const NeighbourView& nv) {
   P.min_neighbours = static_cast<float>(min_neighbours_);
   P.min_flatness = kMinFlatness;
   P.rate = kSingularRate;
+  P.full_colour = static_cast<float>(full_colour_);
   P.n = static_cast<cl_uint>(layout_.n);
   auto& q = cl_.queue();
-  set_args(k_delta_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
-           nv.stride, store_[normal_], store_[delta_], store_[area_]);
+  set_args(k_inside_, store_[core_.phase], inside_, P.n, nv.stride);
+  launch(q, k_inside_, nv.stride);
+  set_args(k_delta_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid, P,
+           nv.stride, store_[normal_], store_[delta_], delta_lanes_, store_[area_]);
   launch(q, k_delta_, layout_.n);
   if (model_ == ExposedArea::Orthmann2013) {
-    set_args(k_area_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
-             nv.stride, store_[delta_], store_[area_]);
+    set_args(k_area_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid, P,
+             nv.stride, delta_lanes_, store_[area_]);
     launch(q, k_area_, layout_.n);
   }
 }

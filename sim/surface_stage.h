@@ -36,9 +36,10 @@ class SurfaceStage {
   ExposedArea model_;
   float support_ = 0;
   double colour_scale_ = 0;
-  double min_neighbours_ = 0;
+  double min_neighbours_ = 0, full_colour_ = 0;
   ParticleStore::Field area_ = 0, normal_ = 0, delta_ = 0;
-  cl::Kernel k_delta_, k_area_;
+  cl::Kernel k_inside_, k_delta_, k_area_;
+  cl::Buffer inside_, delta_lanes_;  // padded blocks of stride floats the neighbour loops read on lanes
 };
 
 }  // namespace thaw

@@ -1,16 +1,8 @@
 /* Each ice and water particle's share of the surface it lies under (sim/surface_stage.h): its surface delta
  * delta_i [1/m], area a_i = v_i delta_i [m^2] (eq. 7 for orthmann2013), outward normal and Zhu & Bridson's
  * signed distance phi. Air is the outside; ice, water and solids are the inside (a face against a wall is
- * not exposed). Built with sph_kernel.h, grid_common.h, wrapped_walk.h and surface_params.h, with
+ * not exposed). Built with sph_kernel.h, grid_common.h, sph_lanes.h, wrapped_walk.h and surface_params.h, with
  * -DTHAW_AREA_<model> (ORTHMANN2013 or BRACKBILL1992). Every particle's rest volume is v = dx^3. */
-
-#ifdef THAW_WENDLAND
-#define SURFACE_W wendland_c2_w
-#define SURFACE_GRAD wendland_c2_grad_factor
-#else
-#define SURFACE_W cubic_spline_w
-#define SURFACE_GRAD cubic_spline_grad_factor
-#endif
 
 /* The eigenvalues of a symmetric 3x3 matrix (a b c / b d e / c e f), ascending (Smith 1961). */
 float3 symmetric_eigenvalues(float a, float b, float c, float d, float e, float f) {
@@ -26,7 +18,20 @@ float3 symmetric_eigenvalues(float a, float b, float c, float d, float e, float 
   return (float3)(lo, 3.0f * q - hi - lo, hi);
 }
 
-int surface_inside(uchar ph) { return ph != THAW_PHASE_AIR; }
+/* Which particles are inside (ice, water, solids: 1) and which outside (air; and past n: 0), as floats in
+ * a block padded like the structure-of-arrays copy, so the neighbour loops below read it on lanes. */
+kernel void surface_inside(global const uchar* phase, global float* inside, const uint n, const uint stride) {
+  const uint i = get_global_id(0);
+  if (i >= stride) return;
+  inside[i] = (i < n && phase[i] != THAW_PHASE_AIR) ? 1.0f : 0.0f;
+}
+
+/* The minimum-image offsets x_i - x_j of the lanes j.. and r^2 (periodic axes wrap). */
+#define SURFACE_LANES(pi, j)                                            \
+  const floatV ox = THAW_WRAP((pi).x - vloadV(0, X + (j)), P.period_x); \
+  const floatV oy = THAW_WRAP((pi).y - vloadV(0, Y + (j)), P.period_y); \
+  const floatV oz = THAW_WRAP((pi).z - vloadV(0, Z + (j)), P.period_z); \
+  const floatV r2 = ox * ox + oy * oy + oz * oz;
 
 /* One pass over the neighbours: the centre of mass m_i (eq. 3) and phi (eq. 2), the colour gradient
  * grad c_i = sum_j v_j grad W_ij, the covariance C_i (eq. 8) and the neighbour count; then the delta:
@@ -35,62 +40,86 @@ int surface_inside(uchar ph) { return ph != THAW_PHASE_AIR; }
  *     scaled so a flat face on the scene's lattice sums to its area; where the neighbourhood is singular, a
  *     sheet's 2 / t (t its thickness from C's least eigenvalue: both faces) or, for a filament or a lone
  *     particle, the area of a sphere of its volume.
- * In singular neighbourhoods delta relaxes at eq. 9's rate from its last value (NaN: none yet). */
+ * In singular neighbourhoods delta relaxes at eq. 9's rate from its last value (NaN: none yet). The sums
+ * run on lanes (grid_common.h) with the kernel's normalisation factored out. delta_lanes: delta again, in
+ * a padded block for surface_area's lanes. */
 kernel void surface_delta(global const float4* pos, global const uchar* phase, global const float* soa,
-                          global const uint* cell_start, const Grid g, const SurfaceParams P, const uint stride,
-                          global float4* normal, global float* delta, global float* area) {
+                          global const float* inside, global const uint* cell_start, const Grid g,
+                          const SurfaceParams P, const uint stride, global float4* normal, global float* delta,
+                          global float* delta_lanes, global float* area) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uchar ph = phase[i];
   if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) {
     normal[i] = (float4)(0.0f);
     delta[i] = 0.0f;
+    delta_lanes[i] = 0.0f;
     area[i] = 0.0f;
     return;
   }
-  const float H = P.support, H2 = H * H, v = P.volume, d = P.radius;
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H, v = P.volume, d = P.radius;
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   global const float* X = soa;
   global const float* Y = soa + stride;
   global const float* Z = soa + 2 * stride;
-  float sw = 0.0f, count = 0.0f;
-  float3 sd = (float3)(0.0f), grad = (float3)(0.0f);
-  float cxx = 0.0f, cxy = 0.0f, cxz = 0.0f, cyy = 0.0f, cyz = 0.0f, czz = 0.0f;
+  floatV sw = (floatV)(0.0f), count = (floatV)(0.0f);
+  floatV sx = (floatV)(0.0f), sy = (floatV)(0.0f), sz = (floatV)(0.0f);
+  floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
-    for (uint j = jb; j < je; ++j) {
-      if (!surface_inside(phase[j])) continue;
-      /* x_j - x_i, the minimum image along periodic axes */
-      const float ex = -THAW_WRAP(pi.x - X[j], P.period_x), ey = -THAW_WRAP(pi.y - Y[j], P.period_y),
-                  ez = -THAW_WRAP(pi.z - Z[j], P.period_z);
-      const float r2 = ex * ex + ey * ey + ez * ez;
-      if (r2 >= H2) continue;
-      const float r = sqrt(r2);
-      const float w = SURFACE_W(r, H);
+    for (uint j = jb; j < je; j += THAW_VW) {
+      SURFACE_LANES(pi, j)
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV q = sqrt(r2) * inv_H;
+      const floatV on = select((floatV)(0.0f), vloadV(0, inside + j), in);
+      const floatV w = on * w_shape(q);
+      const floatV gr = on * grad_shape(q); /* grad_i W_ij = sigma / H^2 grad_shape(q) (x_i - x_j) */
       sw += w;
-      count += 1.0f;
-      sd += w * (float3)(ex, ey, ez);
-      grad -= SURFACE_GRAD(r, H) * (float3)(ex, ey, ez); /* grad_i W_ij = W'(r) / r (x_i - x_j) */
-      cxx += w * ex * ex;
-      cxy += w * ex * ey;
-      cxz += w * ex * ez;
-      cyy += w * ey * ey;
-      cyz += w * ey * ez;
-      czz += w * ez * ez;
+      count += on;
+      /* x_j - x_i = -(ox, oy, oz) */
+      sx -= w * ox;
+      sy -= w * oy;
+      sz -= w * oz;
+      gx += gr * ox;
+      gy += gr * oy;
+      gz += gr * oz;
     }
   }
-  const float3 m = sd / sw; /* m_i - x_i (eq. 3, equal volumes) */
-  const float phi = length(m) - d; /* eq. 2 */
-  grad *= v;
+  const float inv = 1.0f / lanes_sum(sw);
+  const float3 m = (float3)(lanes_sum(sx), lanes_sum(sy), lanes_sum(sz)) * inv; /* m_i - x_i (eq. 3) */
+  const float phi = length(m) - d;                                              /* eq. 2 */
+  const float3 grad = (v * THAW_SIGMA(H) * inv_H * inv_H) * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
   const float g_len = length(grad);
   const float3 n = g_len > 0.0f ? -grad / g_len : (float3)(0.0f);
-  /* eq. 8 about m_i: sum_j W (x_j - m)(x_j - m)^T / sum_j W = sum_j W e e^T / sum_j W - m m^T */
-  const float inv = 1.0f / sw;
-  const float3 lam = symmetric_eigenvalues(cxx * inv - m.x * m.x, cxy * inv - m.x * m.y, cxz * inv - m.x * m.z,
-                                           cyy * inv - m.y * m.y, cyz * inv - m.y * m.z, czz * inv - m.z * m.z);
+  /* eq. 8's covariance about m_i, sum_j W (x_j - m)(x_j - m)^T / sum_j W, only where the neighbourhood lacks
+   * particles (its colour below P.full_colour): a full one is neither sparse nor flat, and most particles are
+   * full, so the second walk is skipped for them. */
+  float3 lam = (float3)(1.0f);
+  if (v * THAW_SIGMA(H) * lanes_sum(sw) < P.full_colour) {
+    const float4 mi = (float4)(pi.x + m.x, pi.y + m.y, pi.z + m.z, 0.0f);
+    floatV cxx = (floatV)(0.0f), cxy = (floatV)(0.0f), cxz = (floatV)(0.0f), cyy = (floatV)(0.0f),
+           cyz = (floatV)(0.0f), czz = (floatV)(0.0f);
+    FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
+      for (uint j = jb; j < je; j += THAW_VW) {
+        SURFACE_LANES(pi, j)
+        const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+        const floatV w = select((floatV)(0.0f), vloadV(0, inside + j), in) * w_shape(sqrt(r2) * inv_H);
+        /* x_j - m_i, with the same minimum image as x_j - x_i */
+        const floatV ex = -ox - m.x, ey = -oy - m.y, ez = -oz - m.z;
+        cxx += w * ex * ex;
+        cxy += w * ex * ey;
+        cxz += w * ex * ez;
+        cyy += w * ey * ey;
+        cyz += w * ey * ez;
+        czz += w * ez * ez;
+      }
+    }
+    lam = symmetric_eigenvalues(lanes_sum(cxx) * inv, lanes_sum(cxy) * inv, lanes_sum(cxz) * inv,
+                                lanes_sum(cyy) * inv, lanes_sum(cyz) * inv, lanes_sum(czz) * inv);
+  }
   const float tr = max(lam.x + lam.y + lam.z, 1e-30f);
   const float flatness = 27.0f * max(lam.x, 0.0f) * max(lam.y, 0.0f) * max(lam.z, 0.0f) / (tr * tr * tr);
-  const int singular = count < P.min_neighbours || flatness < P.min_flatness;
+  const int singular = lanes_sum(count) < P.min_neighbours || flatness < P.min_flatness;
 #ifdef THAW_AREA_ORTHMANN2013
   /* eq. 6, and delta_max = 1/d in singular neighbourhoods (sec. 4.3) */
   const float target = singular ? 1.0f / d : (phi < 0.0f ? (1.0f + phi / d) / d : 0.0f);
@@ -108,6 +137,7 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
   const float last = delta[i];
   const float di = (singular && !isnan(last)) ? (1.0f - P.rate) * last + P.rate * target : target; /* eq. 9 */
   delta[i] = di;
+  delta_lanes[i] = di;
   normal[i] = (float4)(n, phi);
   area[i] = v * di; /* orthmann2013: replaced by eq. 7 in surface_area */
 }
@@ -116,31 +146,29 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
 /* Orthmann eq. 7 with the Shepard-corrected kernel (Bonet & Kulasegaram 2002):
  * a_i = v_i sum_j delta_j v_j W_ij / sum_l v_l W_il over the inside's particles. */
 kernel void surface_area(global const float4* pos, global const uchar* phase, global const float* soa,
-                         global const uint* cell_start, const Grid g, const SurfaceParams P, const uint stride,
-                         global const float* delta, global float* area) {
+                         global const float* inside, global const uint* cell_start, const Grid g,
+                         const SurfaceParams P, const uint stride, global const float* delta_lanes,
+                         global float* area) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uchar ph = phase[i];
   if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) return;
-  const float H = P.support, H2 = H * H;
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   global const float* X = soa;
   global const float* Y = soa + stride;
   global const float* Z = soa + 2 * stride;
-  float sw = 0.0f, sdw = 0.0f;
+  floatV sw = (floatV)(0.0f), sdw = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
-    for (uint j = jb; j < je; ++j) {
-      if (!surface_inside(phase[j])) continue;
-      const float ex = THAW_WRAP(pi.x - X[j], P.period_x), ey = THAW_WRAP(pi.y - Y[j], P.period_y),
-                  ez = THAW_WRAP(pi.z - Z[j], P.period_z);
-      const float r2 = ex * ex + ey * ey + ez * ez;
-      if (r2 >= H2) continue;
-      const float w = SURFACE_W(sqrt(r2), H);
+    for (uint j = jb; j < je; j += THAW_VW) {
+      SURFACE_LANES(pi, j)
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV w = select((floatV)(0.0f), vloadV(0, inside + j), in) * w_shape(sqrt(r2) * inv_H);
       sw += w;
-      sdw += w * delta[j];
+      sdw += w * vloadV(0, delta_lanes + j);
     }
   }
-  area[i] = P.volume * sdw / sw;
+  area[i] = P.volume * lanes_sum(sdw) / lanes_sum(sw);
 }
 #endif

@@ -17,11 +17,13 @@ typedef struct {
   float min_neighbours; /* fewer neighbours than this: a singular neighbourhood (eq. 8's test) */
   float min_flatness;   /* det C / (tr C / 3)^3 below this: a flat one (eq. 8) */
   float rate;           /* Orthmann eq. 9's kappa in singular neighbourhoods */
+  float full_colour;    /* sum_j v W_ij at or above this: a full neighbourhood (no eq. 8 walk) */
   unsigned int n;       /* particles */
+  unsigned int pad0, pad1, pad2;
 } SurfaceParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(SurfaceParams) == 48, "SurfaceParams must match its OpenCL layout");
+static_assert(sizeof(SurfaceParams) == 64, "SurfaceParams must match its OpenCL layout");
 }  // namespace thaw::surface
 #endif
 
