@@ -70,32 +70,14 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double rate = h * Ta / (rho * L);  // dR/dt [m/s], T_m = 0 °C
   const double t_end = double(prm["radius_loss"]) * R0 / rate;
   const double half = R0 + 3 * dx;
-  const Json doc = {
-      {"name", "validation/ambient-sphere"},
-      {"domain", {{"min", {-half, -half, -half}}, {"max", {half, half, half}}}},
-      {"gravity", {0, 0, 0}},
-      {"spacing", dx},
-      {"solver", prm["solver"]},
-      {"ambient", {{"heat_transfer_coefficient", h}, {"temperature", Ta}}},
-      {"heat", {{"exposed_area", prm["model"]}}},
-      {"materials",
-       {{"water",
-         {{"kind", "fluid"}, {"density", 1000.0}, {"conductivity", 0.56}, {"specific_heat", 4217.0}}},
-        {"ice",
-         {{"kind", "ice"},
-          {"density", rho},
-          {"conductivity", prm["conductivity"]},
-          {"specific_heat", prm["specific_heat"]},
-          {"melts_into", "water"},
-          {"latent_heat", L},
-          {"melting_point", 0.0}}}}},
-      {"ice",
-       {{{"material", "ice"},
-         {"shape", "sphere"},
-         {"centre", {0, 0, 0}},
-         {"radius", R0},
-         {"temperature", 0.0}}}},
-  };
+  const Json ice = {{"density", rho},
+                    {"conductivity", prm["conductivity"]},
+                    {"specific_heat", prm["specific_heat"]},
+                    {"latent_heat", L}};
+  const Json sphere = {
+      {"material", "ice"}, {"shape", "sphere"}, {"centre", {0, 0, 0}}, {"radius", R0}, {"temperature", 0.0}};
+  const Json doc = ice_in_air_scene("validation/ambient-sphere", half, dx, prm["solver"], h, Ta, prm["model"],
+                                    ice, sphere);
   const Scene scene = scene_from_json(doc);
   const auto table = material_thermal_table(scene, 1000.0);
   SimState st = initial_state(scene);

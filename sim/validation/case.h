@@ -59,6 +59,13 @@ ValidationCase air_water_case();
 ValidationCase surface_area_case();
 ValidationCase ambient_sphere_case();
 
+// A scene of ice held in still air, for the surface cases (sim/validation/surface_area.cpp): the cube
+// [-half, half]^3 at spacing dx without gravity, the ambient at air_temperature through h, heat.exposed_area
+// `model`, the materials "ice" (density, conductivity, specific_heat and latent_heat from `ice`, melting at
+// 0 °C) and the "water" it melts into; `ice_object` is its one ice entry.
+Json ice_in_air_scene(const std::string& name, double half, double dx, const Json& solver, double h,
+                      double air_temperature, const Json& model, const Json& ice, const Json& ice_object);
+
 // Churchill's correlation for natural convection around a sphere: Nu(Ra, Pr) (sim/validation/air_sphere.cpp).
 double churchill_sphere_nusselt(double rayleigh, double prandtl);
 

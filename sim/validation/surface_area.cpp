@@ -45,31 +45,13 @@ double summed_area(ClRuntime& cl, const Json& prm, const std::vector<Eigen::Vect
   double reach = 0;
   for (const auto& p : points) reach = std::max(reach, p.cwiseAbs().maxCoeff());
   const double L = reach + 4 * dx;
-  Json doc = {
-      {"name", "validation/surface-area"},
-      {"domain", {{"min", {-L, -L, -L}}, {"max", {L, L, L}}}},
-      {"gravity", {0, 0, 0}},
-      {"spacing", dx},
-      {"solver", prm["solver"]},
-      {"ambient", {{"heat_transfer_coefficient", 10.0}, {"temperature", 20.0}}},
-      {"heat", {{"exposed_area", prm["model"]}}},
-      {"materials",
-       {{"water",
-         {{"kind", "fluid"}, {"density", 1000.0}, {"conductivity", 0.56}, {"specific_heat", 4217.0}}},
-        {"ice",
-         {{"kind", "ice"},
-          {"density", 1000.0},
-          {"conductivity", 2.22},
-          {"specific_heat", 2050.0},
-          {"melts_into", "water"},
-          {"latent_heat", 334000.0},
-          {"melting_point", 0.0}}}}},
-      {"ice",
-       {{{"material", "ice"},
-         {"box", {{"min", {-dx, -dx, -dx}}, {"max", {dx, dx, dx}}}},
-         {"temperature", -10.0}}}},
-  };
-  const Scene scene = scene_from_json(doc);
+  const Json ice = {
+      {"density", 1000.0}, {"conductivity", 2.22}, {"specific_heat", 2050.0}, {"latent_heat", 334000.0}};
+  const Json block = {{"material", "ice"},
+                      {"box", {{"min", {-dx, -dx, -dx}}, {"max", {dx, dx, dx}}}},
+                      {"temperature", -10.0}};
+  const Scene scene = scene_from_json(ice_in_air_scene("validation/surface-area", L, dx, prm["solver"], 10.0,
+                                                       20.0, prm["model"], ice, block));
   SimState st = initial_state(scene);
   HostParticles& p = st.particles;
   const HostParticles one = p;
@@ -155,6 +137,28 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
 }
 
 }  // namespace
+
+Json ice_in_air_scene(const std::string& name, double half, double dx, const Json& solver, double h,
+                      double air_temperature, const Json& model, const Json& ice, const Json& ice_object) {
+  Json ice_material = ice;
+  ice_material["kind"] = "ice";
+  ice_material["melts_into"] = "water";
+  ice_material["melting_point"] = 0.0;
+  return {
+      {"name", name},
+      {"domain", {{"min", {-half, -half, -half}}, {"max", {half, half, half}}}},
+      {"gravity", {0, 0, 0}},
+      {"spacing", dx},
+      {"solver", solver},
+      {"ambient", {{"heat_transfer_coefficient", h}, {"temperature", air_temperature}}},
+      {"heat", {{"exposed_area", model}}},
+      {"materials",
+       {{"water",
+         {{"kind", "fluid"}, {"density", 1000.0}, {"conductivity", 0.56}, {"specific_heat", 4217.0}}},
+        {"ice", ice_material}}},
+      {"ice", {ice_object}},
+  };
+}
 
 ValidationCase surface_area_case() {
   return {"surface-area",
