@@ -50,6 +50,7 @@ SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields
   const bool wendland = scene.solver.kernel == KernelFunction::WendlandC2;
   auto grad = wendland ? sph::wendland_c2_grad_factor : sph::cubic_spline_grad_factor;
   colour_scale_ = 1.0 / sph::flat_face_colour_gradient(grad, scene.spacing, k.support);
+  rim_scale_ = 1.0 / sph::flat_edge_colour_gradient(grad, scene.spacing, k.support);
   int count = 0;
   const int m = static_cast<int>(std::ceil(k.support / scene.spacing));
   for (int a = -m; a <= m; ++a)
@@ -95,6 +96,7 @@ void SurfaceStage::run(const NeighbourView& nv) {
   P.min_flatness = kMinFlatness;
   P.rate = kSingularRate;
   P.full_colour = static_cast<float>(full_colour_);
+  P.rim_scale = static_cast<float>(rim_scale_);
   P.n = static_cast<cl_uint>(layout_.n);
   auto& q = cl_.queue();
   set_args(k_inside_, store_[core_.phase], inside_, P.n, nv.stride);

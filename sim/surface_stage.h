@@ -35,7 +35,7 @@ class SurfaceStage {
   const ParticleLayout& layout_;
   ExposedArea model_;
   float support_ = 0;
-  double colour_scale_ = 0;
+  double colour_scale_ = 0, rim_scale_ = 0;
   double min_neighbours_ = 0, full_colour_ = 0;
   ParticleStore::Field area_ = 0, normal_ = 0, delta_ = 0;
   cl::Kernel k_inside_, k_delta_, k_area_;

@@ -95,6 +95,29 @@ inline double flat_face_colour_gradient(float (*grad)(float, float), double spac
   return total / (spacing * spacing);
 }
 
+/* Host only: the same for the rim of a sheet one particle thick: sum over the particles of one row running in
+ * from a straight edge of the sheet (a half-plane of the square lattice, dx apart) of v |grad c_i|, divided
+ * by the rim's dx^2 (a rim one spacing high and one long). Its inverse scales a thin sheet's in-plane colour
+ * gradient to its rim (sim/kernels/surface.cl). */
+inline double flat_edge_colour_gradient(float (*grad)(float, float), double spacing, double support) {
+  const auto H = static_cast<float>(support);
+  const int m = static_cast<int>(std::ceil(support / spacing)) + 1;
+  const double v = spacing * spacing * spacing;
+  double total = 0;
+  for (int k = 0; k <= m; ++k) {  // the particle k spacings in from the edge
+    double gx = 0;
+    for (int l = 0; l <= k + m; ++l)  // neighbours l - k further in, within the half-plane
+      for (int j = -m; j <= m; ++j) {
+        const int dxl = l - k;
+        const double r = spacing * std::sqrt(double(dxl * dxl + j * j));
+        if (r == 0 || r >= support) continue;
+        gx += grad(static_cast<float>(r), H) * (-dxl * spacing);
+      }
+    total += v * std::abs(v * gx);
+  }
+  return total / (spacing * spacing);
+}
+
 /* Host only: the largest eigenvalue of the Jacobi-preconditioned pressure system D^-1 A of DFSPH's
  * solves (sim/kernels/dfsph.cl) on a resting simple cubic lattice, from its Fourier symbol. A pressure
  * wave pi_j = exp(i k.x_j) changes each particle's density by -dt^2 V^2 / rho0 |s(k)|^2 pi, with

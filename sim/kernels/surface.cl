@@ -95,6 +95,7 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
    * particles (its colour below P.full_colour): a full one is neither sparse nor flat, and most particles are
    * full, so the second walk is skipped for them. */
   float3 lam = (float3)(1.0f);
+  float3 across = (float3)(0.0f); /* the eigenvector of C's least eigenvalue: a sheet's normal */
   if (v * THAW_SIGMA(H) * lanes_sum(sw) < P.full_colour) {
     const float4 mi = (float4)(pi.x + m.x, pi.y + m.y, pi.z + m.z, 0.0f);
     floatV cxx = (floatV)(0.0f), cxy = (floatV)(0.0f), cxz = (floatV)(0.0f), cyy = (floatV)(0.0f),
@@ -114,8 +115,16 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
         czz += w * ez * ez;
       }
     }
-    lam = symmetric_eigenvalues(lanes_sum(cxx) * inv, lanes_sum(cxy) * inv, lanes_sum(cxz) * inv,
-                                lanes_sum(cyy) * inv, lanes_sum(cyz) * inv, lanes_sum(czz) * inv);
+    const float a = lanes_sum(cxx) * inv, b = lanes_sum(cxy) * inv, e = lanes_sum(cxz) * inv,
+                dd = lanes_sum(cyy) * inv, f = lanes_sum(cyz) * inv, k = lanes_sum(czz) * inv;
+    lam = symmetric_eigenvalues(a, b, e, dd, f, k);
+    /* (C - lam I) x = 0: x is across two of its rows; the longest of the three crosses */
+    const float3 r0 = (float3)(a - lam.x, b, e), r1 = (float3)(b, dd - lam.x, f), r2 = (float3)(e, f, k - lam.x);
+    const float3 x01 = cross(r0, r1), x02 = cross(r0, r2), x12 = cross(r1, r2);
+    const float l01 = dot(x01, x01), l02 = dot(x02, x02), l12 = dot(x12, x12);
+    const float3 best = l01 >= l02 && l01 >= l12 ? x01 : (l02 >= l12 ? x02 : x12);
+    const float lb = length(best);
+    if (lb > 0.0f) across = best / lb;
   }
   const float tr = max(lam.x + lam.y + lam.z, 1e-30f);
   const float flatness = 27.0f * max(lam.x, 0.0f) * max(lam.y, 0.0f) * max(lam.z, 0.0f) / (tr * tr * tr);
@@ -129,9 +138,14 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
     const float h = P.spacing;
     /* a filament or a lone particle: two directions without extent */
     const int line = max(lam.y, 0.0f) < 0.05f * h * h;
-    /* a sheet of k layers dx apart has sum (z - mean)^2 / k = dx^2 (k^2 - 1) / 12 across it */
+    /* a sheet of k layers dx apart has sum (z - mean)^2 / k = dx^2 (k^2 - 1) / 12 across it: its faces; where
+     * flat, the colour gradient along it is its rim, scaled to the rim's area (t high) as a flat face's is */
     const float t = h * sqrt(1.0f + 12.0f * max(lam.x, 0.0f) / (h * h));
-    target = line ? 4.8359744f / h /* (36 pi)^(1/3) v^(2/3) / v */ : max(2.0f / t, target);
+    const int flat = flatness < P.min_flatness;
+    const float across_g = dot(grad, across);
+    const float along = flat ? length(grad - across_g * across) : 0.0f;
+    const float face = flat ? P.colour_scale * fabs(across_g) : target;
+    target = line ? 4.8359744f / h /* (36 pi)^(1/3) v^(2/3) / v */ : max(2.0f / t, face) + (t / h) * P.rim_scale * along;
   }
 #endif
   const float last = delta[i];

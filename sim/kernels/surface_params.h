@@ -19,7 +19,8 @@ typedef struct {
   float rate;           /* Orthmann eq. 9's kappa in singular neighbourhoods */
   float full_colour;    /* sum_j v W_ij at or above this: a full neighbourhood (no eq. 8 walk) */
   unsigned int n;       /* particles */
-  unsigned int pad0, pad1, pad2;
+  float rim_scale; /* brackbill1992, a sheet one particle thick: its rim's area over sum_i v |grad c_i| */
+  unsigned int pad1, pad2;
 } SurfaceParams;
 
 #ifndef __OPENCL_VERSION__
