@@ -70,52 +70,41 @@ inline double lattice_sum(float (*w)(float, float), double spacing, double suppo
   return sum * spacing * spacing * spacing;
 }
 
-/* Host only: sum over the particles under one dx^2 of a flat face of v |grad c_i|, grad c_i = sum_j v grad
- * W_ij over a half-space of the simple cubic lattice (its top layer dx/2 below the face, v = dx^3), divided
- * by dx^2. The continuum gives 1/2 (c falls from 1 to 1/2 inside); the lattice sums to 0.510 for the cubic
- * spline at H = 2 dx. Its inverse scales brackbill1992's areas (sim/kernels/surface.cl). `grad` is
- * grad_factor: (dW/dr) / r. */
-inline double flat_face_colour_gradient(float (*grad)(float, float), double spacing, double support) {
+/* Host only: sum over a row of particles running in from a flat boundary of v |grad c_i|, grad c_i = sum_j v
+ * grad W_ij over the particles on the boundary's inner side (v = dx^3, the first particle dx/2 in), divided
+ * by dx^2: for a half-space of the simple cubic lattice (`one_layer` false), under one dx^2 of its face; for
+ * a sheet one particle thick (`one_layer` true), behind one dx^2 of its rim (one spacing high, one long).
+ * `grad` is grad_factor: (dW/dr) / r. */
+inline double flat_colour_gradient(float (*grad)(float, float), double spacing, double support,
+                                   bool one_layer) {
   const auto H = static_cast<float>(support);
   const int m = static_cast<int>(std::ceil(support / spacing)) + 1;
+  const int across = one_layer ? 0 : m;  // the sheet's own layer only
   const double v = spacing * spacing * spacing;
   double total = 0;
-  for (int k = 0; k <= m; ++k) {  // the layer k spacings below the top one
-    double gz = 0;
-    for (int i = -m; i <= m; ++i)
+  for (int k = 0; k <= m; ++k) {  // the particle k spacings in
+    double g = 0;
+    for (int i = -across; i <= across; ++i)
       for (int j = -m; j <= m; ++j)
-        for (int l = 0; l <= k + m; ++l) {  // neighbours l - k layers below it, within the half-space
-          const int dz = l - k;
-          const double r = spacing * std::sqrt(double(i * i + j * j + dz * dz));
+        for (int l = 0; l <= k + m; ++l) {  // neighbours l - k further in, on the inner side
+          const int d = l - k;
+          const double r = spacing * std::sqrt(double(i * i + j * j + d * d));
           if (r == 0 || r >= support) continue;
-          gz += grad(static_cast<float>(r), H) * (-dz * spacing);  // (x_i - x_j).z
+          g += grad(static_cast<float>(r), H) * (-d * spacing);  // (x_i - x_j) along the row
         }
-    total += v * std::abs(v * gz);
+    total += v * std::abs(v * g);
   }
   return total / (spacing * spacing);
 }
 
-/* Host only: the same for the rim of a sheet one particle thick: sum over the particles of one row running in
- * from a straight edge of the sheet (a half-plane of the square lattice, dx apart) of v |grad c_i|, divided
- * by the rim's dx^2 (a rim one spacing high and one long). Its inverse scales a thin sheet's in-plane colour
- * gradient to its rim (sim/kernels/surface.cl). */
+/* A flat face's value: the continuum gives 1/2 (c falls from 1 to 1/2 inside); the lattice sums to 0.510 for
+ * the cubic spline at H = 2 dx. Its inverse scales brackbill1992's areas (sim/kernels/surface.cl). */
+inline double flat_face_colour_gradient(float (*grad)(float, float), double spacing, double support) {
+  return flat_colour_gradient(grad, spacing, support, false);
+}
+/* A one-layer sheet's rim: its inverse scales the colour gradient along a sheet to its rim (surface.cl). */
 inline double flat_edge_colour_gradient(float (*grad)(float, float), double spacing, double support) {
-  const auto H = static_cast<float>(support);
-  const int m = static_cast<int>(std::ceil(support / spacing)) + 1;
-  const double v = spacing * spacing * spacing;
-  double total = 0;
-  for (int k = 0; k <= m; ++k) {  // the particle k spacings in from the edge
-    double gx = 0;
-    for (int l = 0; l <= k + m; ++l)  // neighbours l - k further in, within the half-plane
-      for (int j = -m; j <= m; ++j) {
-        const int dxl = l - k;
-        const double r = spacing * std::sqrt(double(dxl * dxl + j * j));
-        if (r == 0 || r >= support) continue;
-        gx += grad(static_cast<float>(r), H) * (-dxl * spacing);
-      }
-    total += v * std::abs(v * gx);
-  }
-  return total / (spacing * spacing);
+  return flat_colour_gradient(grad, spacing, support, true);
 }
 
 /* Host only: the largest eigenvalue of the Jacobi-preconditioned pressure system D^-1 A of DFSPH's
