@@ -69,6 +69,27 @@ TEST_F(SurfaceTest, AmbientHeatEntersThroughTheStagesAreas) {
   EXPECT_NEAR(heat[1] / heat[0], 1.12, 0.05);
 }
 
+// A slab of ice periodic along x and y has two faces and no edges: the wrapped walk sees no rim where the
+// domain wraps, so the areas sum to 2 L^2 (both models of a flat face on its own lattice: exact to rounding).
+TEST_F(SurfaceTest, APeriodicSlabHasItsTwoFacesAndNoEdges) {
+  const Json doc = Json::parse(R"({
+    "name": "periodic-slab", "domain": {"min": [0, 0, 0], "max": [0.02, 0.02, 0.03]}, "spacing": 0.002,
+    "solver": {"flow": false, "max_dt": 0.05, "periodic": ["x", "y"]},
+    "ambient": {"temperature": 25, "heat_transfer_coefficient": 50},
+    "heat": {"exposed_area": "brackbill1992"},
+    "materials": {
+      "water": {"kind": "fluid", "density": 1000, "conductivity": 0.56, "specific_heat": 4217},
+      "ice": {"kind": "ice", "density": 917, "conductivity": 2.22, "specific_heat": 2050, "melts_into": "water"}},
+    "ice": [{"material": "ice", "box": {"min": [0, 0, 0], "max": [0.02, 0.02, 0.01]}, "temperature": -5}]
+  })");
+  const Scene scene = scene_from_json(doc);
+  Solver s(cl(), scene, initial_state(scene));
+  s.warm_up();
+  double area = 0;
+  for (float a : s.surface_areas()) area += a;
+  EXPECT_NEAR(area / (2 * 0.02 * 0.02), 1.0, 1e-4);
+}
+
 TEST_F(SurfaceTest, TheSurfaceAreaCasesSphereAndSheetsHoldAtResolution20) {
   const CaseResult r = run_validation(cl(), "surface-area", 20, {});
   for (const auto& [key, m] : r.metrics) {
