@@ -82,8 +82,8 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   gravity_ = {{static_cast<float>(g.x()), static_cast<float>(g.y()), static_cast<float>(g.z()), 0.0f}};
   // A full neighbourhood holds about (4/3) pi (H / dx)^3 particles; below 60 % of it a particle is at a
   // surface, where the divergence solve leaves it (20 of 33 at H = 2 dx, SPlisHSPlasH's threshold).
-  const double full = 4.0 / 3.0 * M_PI * std::pow(double(k.support) / scene.spacing, 3);
-  min_neighbours_ = static_cast<cl_uint>(std::lround(0.6 * full));
+  min_neighbours_ =
+      static_cast<cl_uint>(std::lround(0.6 * sph::full_neighbourhood(scene.spacing, k.support)));
   rest_density_ = k.rest_density;
   // Multiphase builds measure the errors as fractions of each particle's own rest density (dfsph.cl).
   error_scale_ = scene.multiphase() ? 1.0 : k.rest_density;

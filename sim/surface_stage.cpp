@@ -1,7 +1,7 @@
 #include "sim/surface_stage.h"
 
+#include <bit>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 #include "sim/cl_launch.h"
@@ -16,32 +16,21 @@ namespace {
 // Orthmann et al. 2013 eq. 9: kappa in [0.1, 0.5] for thin sheets; the middle of that range.
 constexpr float kSingularRate = 0.3f;
 // Sec. 4.3 calls a neighbourhood singular below 30 neighbours, for a support that held about twice that many
-// at rest; here the same share of the lattice's count within the support (33 at H = 2 dx): about the count
-// along a box's edge.
+// at rest; here a share of a full neighbourhood (sph::full_neighbourhood, 33.5 at H = 2 dx): 13.4, so a sheet
+// one particle thick (13 within 2 dx) is singular, and about the count along a box's edge.
 constexpr double kSingularShare = 0.4;
 // det C / (tr C / 3)^3 of eq. 8 below this: flat. A sheet one particle thick has 0; a flat face's top layer
 // about 0.5 (cubic spline, H = 2 dx).
 constexpr float kMinFlatness = 0.1f;
 
-std::uint32_t nan_bits() {
-  const float f = std::numeric_limits<float>::quiet_NaN();
-  std::uint32_t u;
-  std::memcpy(&u, &f, 4);
-  return u;
-}
+std::uint32_t nan_bits() { return std::bit_cast<std::uint32_t>(std::numeric_limits<float>::quiet_NaN()); }
 
 }  // namespace
 
 SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
                            const SolverConstants& k, const std::string& build_options,
                            const ParticleLayout& layout)
-    : cl_(cl),
-      store_(store),
-      core_(core),
-      scene_(scene),
-      layout_(layout),
-      model_(scene.heat.exposed_area),
-      support_(k.support) {
+    : cl_(cl), store_(store), core_(core), scene_(scene), layout_(layout), model_(scene.heat.exposed_area) {
   area_ = store.add({"surface_area", FieldType::Float32, 1, false, true});
   normal_ = store.add({"surface_normal", FieldType::Float32, 4, false, true});
   // Saved, so a resumed run relaxes from where it stopped; NaN (none yet) where a state has none.
@@ -49,18 +38,6 @@ SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields
 
   const bool wendland = scene.solver.kernel == KernelFunction::WendlandC2;
   auto grad = wendland ? sph::wendland_c2_grad_factor : sph::cubic_spline_grad_factor;
-  colour_scale_ = 1.0 / sph::flat_face_colour_gradient(grad, scene.spacing, k.support);
-  rim_scale_ = 1.0 / sph::flat_edge_colour_gradient(grad, scene.spacing, k.support);
-  int count = 0;
-  const int m = static_cast<int>(std::ceil(k.support / scene.spacing));
-  for (int a = -m; a <= m; ++a)
-    for (int b = -m; b <= m; ++b)
-      for (int c = -m; c <= m; ++c)
-        if (scene.spacing * std::sqrt(double(a * a + b * b + c * c)) < k.support) ++count;
-  min_neighbours_ = kSingularShare * count;
-  // A neighbourhood with 0.9 of a resting lattice's colour lacks too few particles to be sparse or flat.
-  full_colour_ =
-      0.9 * sph::lattice_sum(wendland ? sph::wendland_c2_w : sph::cubic_spline_w, scene.spacing, k.support);
 
   std::string opts = build_options;
   opts += model_ == ExposedArea::Orthmann2013 ? " -DTHAW_AREA_ORTHMANN2013" : " -DTHAW_AREA_BRACKBILL1992";
@@ -74,37 +51,43 @@ SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields
   k_delta_ = cl::Kernel(program, "surface_delta");
   const std::size_t padded = std::size_t(layout.stride) * 4;
   inside_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
-  delta_lanes_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
-  cl.queue().enqueueFillBuffer(delta_lanes_, 0.0f, 0, padded);
-  if (model_ == ExposedArea::Orthmann2013) k_area_ = cl::Kernel(program, "surface_area");
+  if (model_ == ExposedArea::Orthmann2013) {
+    k_area_ = cl::Kernel(program, "surface_area");
+    delta_lanes_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
+    cl.queue().enqueueFillBuffer(delta_lanes_, 0.0f, 0, padded);
+  }
+
+  const double dx = scene.spacing;
+  params_.support = k.support;
+  params_.volume = static_cast<float>(dx * dx * dx);
+  params_.radius = static_cast<float>(0.5 * dx);
+  params_.spacing = static_cast<float>(dx);
+  float* period[3] = {&params_.period_x, &params_.period_y, &params_.period_z};
+  for (int a = 0; a < 3; ++a)
+    if (scene.solver.periodic[static_cast<std::size_t>(a)])
+      *period[a] = static_cast<float>(scene.domain.max[a] - scene.domain.min[a]);
+  params_.colour_scale = static_cast<float>(1.0 / sph::flat_face_colour_gradient(grad, dx, k.support));
+  params_.rim_scale = static_cast<float>(1.0 / sph::flat_edge_colour_gradient(grad, dx, k.support));
+  params_.min_neighbours = static_cast<float>(kSingularShare * sph::full_neighbourhood(dx, k.support));
+  params_.min_flatness = kMinFlatness;
+  params_.rate = kSingularRate;
+  // A neighbourhood with 0.9 of a resting lattice's colour lacks too few particles to be sparse or flat.
+  params_.full_colour = static_cast<float>(
+      0.9 * sph::lattice_sum(wendland ? sph::wendland_c2_w : sph::cubic_spline_w, dx, k.support));
 }
 
 void SurfaceStage::run(const NeighbourView& nv) {
   if (layout_.n == 0) return;
-  surface::SurfaceParams P{};
-  const double dx = scene_.spacing;
-  P.support = support_;
-  P.volume = static_cast<float>(dx * dx * dx);
-  P.radius = static_cast<float>(0.5 * dx);
-  P.spacing = static_cast<float>(dx);
-  float* period[3] = {&P.period_x, &P.period_y, &P.period_z};
-  for (int a = 0; a < 3; ++a)
-    if (scene_.solver.periodic[static_cast<std::size_t>(a)])
-      *period[a] = static_cast<float>(scene_.domain.max[a] - scene_.domain.min[a]);
-  P.colour_scale = static_cast<float>(colour_scale_);
-  P.min_neighbours = static_cast<float>(min_neighbours_);
-  P.min_flatness = kMinFlatness;
-  P.rate = kSingularRate;
-  P.full_colour = static_cast<float>(full_colour_);
-  P.rim_scale = static_cast<float>(rim_scale_);
+  surface::SurfaceParams P = params_;
   P.n = static_cast<cl_uint>(layout_.n);
   auto& q = cl_.queue();
+  const bool orthmann = model_ == ExposedArea::Orthmann2013;  // brackbill1992 never writes delta_lanes
   set_args(k_inside_, store_[core_.phase], inside_, P.n, nv.stride);
   launch(q, k_inside_, nv.stride);
   set_args(k_delta_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid, P,
-           nv.stride, store_[normal_], store_[delta_], delta_lanes_, store_[area_]);
+           nv.stride, store_[normal_], store_[delta_], orthmann ? delta_lanes_ : inside_, store_[area_]);
   launch(q, k_delta_, layout_.n);
-  if (model_ == ExposedArea::Orthmann2013) {
+  if (orthmann) {
     set_args(k_area_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid, P,
              nv.stride, delta_lanes_, store_[area_]);
     launch(q, k_area_, layout_.n);

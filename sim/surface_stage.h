@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sim/cl_runtime.h"
+#include "sim/kernels/surface_params.h"
 #include "sim/particle_store.h"
 #include "sim/scene.h"
 #include "sim/stage.h"
@@ -34,12 +35,12 @@ class SurfaceStage {
   const Scene& scene_;
   const ParticleLayout& layout_;
   ExposedArea model_;
-  float support_ = 0;
-  double colour_scale_ = 0, rim_scale_ = 0;
-  double min_neighbours_ = 0, full_colour_ = 0;
+  surface::SurfaceParams params_{};  // all but n, from the scene and the kernel at construction
   ParticleStore::Field area_ = 0, normal_ = 0, delta_ = 0;
   cl::Kernel k_inside_, k_delta_, k_area_;
-  cl::Buffer inside_, delta_lanes_;  // padded blocks of stride floats the neighbour loops read on lanes
+  // Padded blocks of stride floats the neighbour loops read on lanes: who is inside, and (orthmann2013's eq 7
+  // only) the deltas.
+  cl::Buffer inside_, delta_lanes_;
 };
 
 }  // namespace thaw

@@ -70,6 +70,13 @@ inline double lattice_sum(float (*w)(float, float), double spacing, double suppo
   return sum * spacing * spacing * spacing;
 }
 
+/* Host only: the particles a full neighbourhood holds, (4/3) pi (H / dx)^3 (33.5 at H = 2 dx; the simple
+ * cubic lattice has 33 within it); the share of it below which a particle is at a surface or in a sheet
+ * (DFSPH's divergence solve, sim/dfsph_stage.cpp; the surface stage, sim/surface_stage.cpp). */
+inline double full_neighbourhood(double spacing, double support) {
+  return 4.0 / 3.0 * M_PI * std::pow(support / spacing, 3);
+}
+
 /* Host only: sum over a row of particles running in from a flat boundary of v |grad c_i|, grad c_i = sum_j v
  * grad W_ij over the particles on the boundary's inner side (v = dx^3, the first particle dx/2 in), divided
  * by dx^2: for a half-space of the simple cubic lattice (`one_layer` false), under one dx^2 of its face; for

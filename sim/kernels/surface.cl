@@ -26,6 +26,15 @@ kernel void surface_inside(global const uchar* phase, global float* inside, cons
   inside[i] = (i < n && phase[i] != THAW_PHASE_AIR) ? 1.0f : 0.0f;
 }
 
+/* A neighbour pass's start: the support, particle i's position and cell, and the structure-of-arrays x, y, z. */
+#define SURFACE_START(pos, soa, stride)             \
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H; \
+  const float4 pi = (pos)[i];                       \
+  const int4 c = grid_cell(g, pi);                  \
+  global const float* X = (soa);                    \
+  global const float* Y = (soa) + (stride);         \
+  global const float* Z = (soa) + 2 * (stride);
+
 /* The minimum-image offsets x_i - x_j of the lanes j.. and r^2 (periodic axes wrap). */
 #define SURFACE_LANES(pi, j)                                            \
   const floatV ox = THAW_WRAP((pi).x - vloadV(0, X + (j)), P.period_x); \
@@ -41,8 +50,8 @@ kernel void surface_inside(global const uchar* phase, global float* inside, cons
  *     sheet's 2 / t (t its thickness from C's least eigenvalue: both faces) or, for a filament or a lone
  *     particle, the area of a sphere of its volume.
  * In singular neighbourhoods delta relaxes at eq. 9's rate from its last value (NaN: none yet). The sums
- * run on lanes (grid_common.h) with the kernel's normalisation factored out. delta_lanes: delta again, in
- * a padded block for surface_area's lanes. */
+ * run on lanes (grid_common.h) with the kernel's normalisation factored out. delta_lanes (orthmann2013
+ * only): delta again, in a padded block for surface_area's lanes. */
 kernel void surface_delta(global const float4* pos, global const uchar* phase, global const float* soa,
                           global const float* inside, global const uint* cell_start, const Grid g,
                           const SurfaceParams P, const uint stride, global float4* normal, global float* delta,
@@ -53,16 +62,14 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
   if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) {
     normal[i] = (float4)(0.0f);
     delta[i] = 0.0f;
+#ifdef THAW_AREA_ORTHMANN2013
     delta_lanes[i] = 0.0f;
+#endif
     area[i] = 0.0f;
     return;
   }
-  const float H = P.support, H2 = H * H, inv_H = 1.0f / H, v = P.volume, d = P.radius;
-  const float4 pi = pos[i];
-  const int4 c = grid_cell(g, pi);
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
+  SURFACE_START(pos, soa, stride)
+  const float v = P.volume, d = P.radius;
   floatV sw = (floatV)(0.0f), count = (floatV)(0.0f);
   floatV sx = (floatV)(0.0f), sy = (floatV)(0.0f), sz = (floatV)(0.0f);
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f);
@@ -151,7 +158,9 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
   const float last = delta[i];
   const float di = (singular && !isnan(last)) ? (1.0f - P.rate) * last + P.rate * target : target; /* eq. 9 */
   delta[i] = di;
+#ifdef THAW_AREA_ORTHMANN2013
   delta_lanes[i] = di;
+#endif
   normal[i] = (float4)(n, phi);
   area[i] = v * di; /* orthmann2013: replaced by eq. 7 in surface_area */
 }
@@ -167,12 +176,7 @@ kernel void surface_area(global const float4* pos, global const uchar* phase, gl
   if (i >= P.n) return;
   const uchar ph = phase[i];
   if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) return;
-  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
-  const float4 pi = pos[i];
-  const int4 c = grid_cell(g, pi);
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
+  SURFACE_START(pos, soa, stride)
   floatV sw = (floatV)(0.0f), sdw = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
