@@ -31,10 +31,7 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
   enthalpy_ = store.add({"enthalpy", FieldType::Float32, 2});
 
   std::string opts = build_options;
-  if (uses_surface())
-    opts += " -DTHAW_SURFACE_AREA";
-  else
-    opts += " -DTHAW_EXPOSED_AREA=iwasaki2010";
+  if (uses_surface()) opts += " -DTHAW_SURFACE_AREA";
   if (plan.ambient) opts += " -DTHAW_AMBIENT";
   if (plan.dryers) opts += " -DTHAW_DRYERS";
   if (plan.walls) opts += " -DTHAW_WALL_HEAT";

@@ -592,6 +592,16 @@ void Solver::trace_photons(double dt) {
 
 NeighbourView Solver::neighbours() const { return grid_->view(); }
 
+void Solver::heat_stages(double dt) {
+  timed(Stage::Photons, [&] { trace_photons(dt); });
+  // Without flow the particles never move: the first pass's areas serve the whole run.
+  if (surface_ && (scene_.solver.flow || !surface_done_)) {
+    timed(Stage::Surface, [&] { surface_->run(neighbours()); });
+    surface_done_ = true;
+  }
+  timed(Stage::Heat, [&] { compute_heat(dt); });
+}
+
 void Solver::compute_heat(double dt) {
   if (!heat_) return;
   // Sub-steps (heat.max_substeps): equal parts of the flow step, each within conduction's limit, with the
@@ -638,14 +648,7 @@ void Solver::step() {
   if (rigid_) timed(Stage::IceForces, [&] { rigid_->compute_forces(buffers()); });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
-  if (heat_) {
-    timed(Stage::Photons, [&] { trace_photons(dt); });
-    if (surface_ && (scene_.solver.flow || !surface_done_)) {
-      timed(Stage::Surface, [&] { surface_->run(neighbours()); });
-      surface_done_ = true;
-    }
-    timed(Stage::Heat, [&] { compute_heat(dt); });
-  }
+  if (heat_) heat_stages(dt);
   if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
   if (flow)
     timed(Stage::Integrate, [&] {
@@ -676,14 +679,7 @@ void Solver::step_dfsph() {
   });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
-  if (heat_) {
-    timed(Stage::Photons, [&] { trace_photons(dt); });
-    if (surface_ && (scene_.solver.flow || !surface_done_)) {
-      timed(Stage::Surface, [&] { surface_->run(neighbours()); });
-      surface_done_ = true;
-    }
-    timed(Stage::Heat, [&] { compute_heat(dt); });
-  }
+  if (heat_) heat_stages(dt);
   timed(Stage::Pressure, [&] {
     dfsph_->predict(fluid_->accel(), neighbours(), dt, 1.0 / (1.0 + damping_ * dt));
     dfsph_->density_solve(neighbours(), dt);

@@ -148,6 +148,7 @@ class Solver {
   double choose_time_step();
   void trace_photons(double dt);  // lamps: photons absorbed this step, as energy per particle
   void compute_heat(double dt);   // conduction, sources, enthalpy update, phase change, budget
+  void heat_stages(double dt);    // photons, the surface's areas where heat reads them, then heat, each timed
   void integrate(double dt);
   // Rigid ice only (no-ops otherwise): label the ice into bodies now, and the ice-force pass; the force
   // on each particle [N] as that pass left it (zero for all but ice of free bodies).

@@ -108,17 +108,12 @@ float2 add_compensated(float2 e, float d) {
   return (float2)(hi, lo - (hi - s));
 }
 
-/* Exposed-area models (heat.exposed_area): the area [m^2] of a particle's surface in contact with air.
- * iwasaki2010 counts the particles that cover it (-DTHAW_EXPOSED_AREA=iwasaki2010); the others are the
- * surface stage's areas (sim/surface_stage.h), read from `area` with -DTHAW_SURFACE_AREA. */
+/* The area [m^2] of a particle's surface in contact with air (heat.exposed_area): the surface stage's areas
+ * (sim/surface_stage.h), read from `area` with -DTHAW_SURFACE_AREA; otherwise Iwasaki et al. 2010 sec. 4's
+ * count of the particles that cover it: dA = (6 - n_i) / 6 of the voxel's A = 6 dx^2, clamped at 0. */
 float exposed_area_iwasaki2010(int neighbours, float face_area) {
-  /* Iwasaki et al. 2010 sec. 4: dA = (6 - n_i) / 6 of the voxel's A = 6 dx^2, clamped at 0. */
   return face_area * (float)max(6 - neighbours, 0);
 }
-#ifndef THAW_EXPOSED_AREA
-#define THAW_EXPOSED_AREA iwasaki2010
-#endif
-#define THAW_EXPOSED_FN THAW_CAT(exposed_area_, THAW_EXPOSED_AREA)
 
 /* Source categories of the energy budget, blocks of `stride` floats in `budget` [J this step]. */
 #define THAW_SRC_AMBIENT 0
@@ -199,7 +194,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
 #ifdef THAW_SURFACE_AREA
   const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? area[i] : 0.0f;
 #else
-  const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? THAW_EXPOSED_FN(neighbours, face_area) : 0.0f;
+  const float exposed = (m.flags & THAW_MAT_AIR_EXCHANGE) ? exposed_area_iwasaki2010(neighbours, face_area) : 0.0f;
 #endif
   if (exposed > 0.0f) {
 #ifdef THAW_AMBIENT
