@@ -65,6 +65,17 @@ const char* name(ExposedArea a) {
   }
   return "iwasaki2010";
 }
+const char* name(TensionModel m) {
+  switch (m) {
+    case TensionModel::Akinci2013:
+      return "akinci2013";
+    case TensionModel::Iwasaki2010:
+      return "iwasaki2010";
+    case TensionModel::None:
+      break;
+  }
+  return "none";
+}
 const char* name(DfsphBoundary b) { return b == DfsphBoundary::Akinci2012 ? "akinci2012" : "adami2012"; }
 const char* name(Multiphase m) {
   return m == Multiphase::DomaradzkiMartyn ? "domaradzki_martyn" : "hu_adams2006";
@@ -288,6 +299,17 @@ HeatSettings heat_settings_from_json(const Json& doc) {
   return h;
 }
 
+TensionSettings tension_settings_from_json(const Json& t) {
+  TensionSettings s;
+  s.model = choice_of<TensionModel>(
+      t["model"], {TensionModel::None, TensionModel::Akinci2013, TensionModel::Iwasaki2010});
+  s.coefficient = t["coefficient"].get<double>();
+  s.curvature = t["curvature"].get<bool>();
+  s.solid_contact_angle = t["solid_contact_angle"].get<double>();
+  s.ice_contact_angle = t["ice_contact_angle"].get<double>();
+  return s;
+}
+
 double temperature_or(const Json& object, double fallback) {
   return object.contains("temperature") ? object["temperature"].get<double>() : fallback;
 }
@@ -306,15 +328,15 @@ void check_start(const Scene& s, int material, double T, const std::string& path
 
 // `materials` is the document's block, for the names; `s` has the domain, the materials and the ambient
 // temperature (a block without one starts at it).
-FluidBlock fluid_block_from_json(const Json& f, const std::string& path, const Scene& s,
-                                 const Json& materials) {
+FluidBlock fluid_block_from_json(Json& f, const std::string& path, const Scene& s, const Json& materials,
+                                 const std::string& folder) {
   FluidBlock block;
   block.material = material_index(materials, f["material"], path + ".material", "fluid", "a fluid block");
-  block.box = box(f["box"]);
+  block.shape = shape_of(f, path, folder);
+  block.box = box_of(block.shape);
   block.velocity = vec(f["velocity"]);
   block.temperature = temperature_or(f, s.heat.ambient_temperature);
-  check_box(block.box, path + ".box", "empty box");
-  check_inside(s.domain, block.box, path + ".box");
+  check_inside(s.domain, block.box, block.shape.axis_aligned_box() ? path + ".box" : path);
   check_start(s, block.material, block.temperature, path + (f.contains("temperature") ? ".temperature" : ""));
   return block;
 }
@@ -442,6 +464,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     }
   }
   s.heat = heat_settings_from_json(doc);
+  s.tension = tension_settings_from_json(doc["tension"]);
   s.camera = camera_from_json(doc["camera"]);
 
   s.walls = domain["walls"].get<std::vector<std::string>>();
@@ -493,7 +516,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   }
 
   for (std::size_t i = 0; i < doc["fluids"].size(); ++i)
-    s.fluids.push_back(fluid_block_from_json(doc["fluids"][i], join_path("fluids", i), s, materials));
+    s.fluids.push_back(fluid_block_from_json(doc["fluids"][i], join_path("fluids", i), s, materials, folder));
   for (std::size_t i = 0; i < doc["ice"].size(); ++i)
     s.ice.push_back(ice_block_from_json(doc["ice"][i], join_path("ice", i), s, materials, folder));
   if (doc.contains("air")) s.air = air_fill_from_json(doc["air"], s, materials);

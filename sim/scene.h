@@ -39,6 +39,9 @@ enum class DfsphBoundary { Adami2012, Akinci2012 };
 // How fluids of several rest densities meet (dfsph, sim/kernels/dfsph.cl).
 enum class Multiphase { HuAdams2006, DomaradzkiMartyn };
 enum class ExposedArea { Iwasaki2010, Orthmann2013, Brackbill1992 };
+// Interfacial tension (sim/tension_stage.h): none, Akinci et al. 2013's cohesion, curvature and adhesion, or
+// Iwasaki et al. 2010's eq. 4.
+enum class TensionModel { None, Akinci2013, Iwasaki2010 };
 // How walls hold the fluid's tangential velocity: only through boundary_viscosity, or no-slip.
 enum class NoSlip { None, Adami2012 };
 // What a dryer is: an analytic cone of warm air that heats exposed ice and water (scenes without air
@@ -56,6 +59,7 @@ const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
 const char* name(Multiphase m);      // "hu_adams2006", "domaradzki_martyn"
 const char* name(NoSlip n);          // "none", "adami2012"
 const char* name(DryerModel m);      // "cone", "air"
+const char* name(TensionModel m);    // "none", "akinci2013", "iwasaki2010"
 
 struct Material {
   std::string name;
@@ -112,7 +116,8 @@ struct AirFill {
 
 struct FluidBlock {
   int material = 0;  // index into Scene::materials
-  Box box;           // filled with particles on a lattice of the scene's spacing
+  Shape shape;       // filled with particles on a lattice of the scene's spacing (a box unless it says)
+  Box box;           // the shape's bounding box
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   double temperature = 20.0;  // initial [°C]
 };
@@ -193,6 +198,17 @@ struct HeatSettings {
   double wall_temperature = 20.0;     // outside the tank [°C]
 };
 
+// The scene's `tension`: the model, the water-air tension sigma it is calibrated to, and the contact angles
+// water makes on solids and on ice, which set the adhesion (Young-Dupre: W = sigma (1 + cos theta)).
+struct TensionSettings {
+  TensionModel model = TensionModel::None;
+  double coefficient = 0.0756;        // sigma [N/m]: water-air at 0 °C
+  bool curvature = true;              // akinci2013: its curvature term (eq. 5)
+  double solid_contact_angle = 90.0;  // [deg]
+  double ice_contact_angle = 12.0;    // [deg]: water on ice (Knight 1967)
+  bool enabled() const { return model != TensionModel::None; }
+};
+
 struct SolverSettings {
   KernelFunction kernel = KernelFunction::CubicSpline;
   double support_ratio = 2.0;  // kernel support radius / particle spacing
@@ -268,6 +284,7 @@ struct Scene {
   std::vector<IceBlock> ice;
   std::vector<Solid> solids;
   HeatSettings heat;
+  TensionSettings tension;
   std::vector<Lamp> lamps;
   std::vector<Dryer> dryers;
   std::vector<Emitter> emitters;

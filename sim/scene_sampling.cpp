@@ -194,12 +194,11 @@ HostParticles sample_scene(const Scene& scene) {
     const auto& f = scene.fluids[b];
     const float mass = static_cast<float>(scene.materials[f.material].density * dx * dx * dx);
     const double h = enthalpy_at(scene, f.material, f.temperature);
-    std::vector<Vec3> points = voxelize(Shape::box(f.box.min, f.box.max), dx);
+    std::vector<Vec3> points = voxelize(f.shape, dx, &scene.domain.min);
     drop_outside(points, scene.domain);
     for (const auto& s : scene.solids) drop_inside(points, s);
     for (const auto& c : scene.ice) drop_inside(points, c.shape);
-    for (std::size_t e = 0; e < b; ++e)
-      drop_inside(points, Shape::box(scene.fluids[e].box.min, scene.fluids[e].box.max));
+    for (std::size_t e = 0; e < b; ++e) drop_inside(points, scene.fluids[e].shape);
     for (const Vec3& x : points) add(p, x, f.velocity, mass, Phase::Water, f.material, h);
   }
   // Air: the domain's lattice over its region, skipping points inside solids, ice or fluid blocks.
@@ -209,7 +208,7 @@ HostParticles sample_scene(const Scene& scene) {
     const double h = enthalpy_at(scene, a.material, a.temperature);
     std::vector<Vec3> points = air_lattice(scene);
     for (const auto& c : scene.ice) drop_inside(points, c.shape);
-    for (const auto& f : scene.fluids) drop_inside(points, Shape::box(f.box.min, f.box.max));
+    for (const auto& f : scene.fluids) drop_inside(points, f.shape);
     if (points.empty())
       throw SceneError("air", "its region holds no particle outside the solids, ice and fluid blocks");
     for (const Vec3& x : points) add(p, x, Vec3::Zero(), mass, Phase::Air, a.material, h);

@@ -325,6 +325,46 @@ const Field& scene_schema() {
               },
               "Heat transfer and phase change (Iwasaki et al. 2010; docs/ARCHITECTURE.md Numerics)."),
           object(
+              "tension",
+              {
+                  choice(
+                      "model", {"none", "akinci2013", "iwasaki2010"},
+                      "Interfacial tension of water (docs/TENSION.md): akinci2013 = Akinci et al. 2013's "
+                      "cohesion and curvature between water particles and adhesion to solids and ice; "
+                      "iwasaki2010 = Iwasaki et al. 2010 eq. 4, an attraction k (x_j - x_i) / r^2 to water "
+                      "and ice neighbours (and here solids). Both are calibrated from `coefficient` and "
+                      "the contact angles below, so that a flat surface of uniformly spread particles "
+                      "has that tension; docs/TENSION.md has how near the simulated drops come. none: no "
+                      "tension stage is built")
+                      .def("none"),
+                  number("coefficient",
+                         "Water-air surface tension sigma; 0.0756 at 0 °C, 0.0728 at 20 °C. A scene that "
+                         "scales it says so in its description")
+                      .in("N/m")
+                      .def(0.0756)
+                      .above(0)
+                      .at_most(10)
+                      .client_settable(),
+                  flag("curvature", "akinci2013: include its curvature (surface-minimising) term")
+                      .def(true)
+                      .client_settable(),
+                  number("solid_contact_angle",
+                         "Contact angle water makes on the solids and walls; sets their adhesion by "
+                         "Young-Dupre, W = sigma (1 + cos theta); 180 = none")
+                      .in("deg")
+                      .def(90.0)
+                      .at_least(0)
+                      .at_most(180)
+                      .client_settable(),
+                  number("ice_contact_angle", "Contact angle water makes on ice (about 12, Knight 1967)")
+                      .in("deg")
+                      .def(12.0)
+                      .at_least(0)
+                      .at_most(180)
+                      .client_settable(),
+              },
+              "Surface tension of water and its adhesion to solids and ice; needs solver.flow."),
+          object(
               "camera",
               {
                   number("azimuth", "Angle about the vertical axis, from +x towards +y")
@@ -412,17 +452,23 @@ const Field& scene_schema() {
                  "Materials by name; objects refer to them by name.")
               .non_empty(),
           array_of("fluids",
-                   {
+                   shaped_entry(
+                       choice("shape", {"box", "sphere", "cylinder", "cone", "capsule", "mesh"},
+                              "What the fluid fills: an axis-aligned box (turned by rotation), a sphere (a "
+                              "drop), a cylinder, a cone, a capsule or a mesh file")
+                           .def("box"),
                        text("material", "Name of a fluid material"),
-                       box_field("box", "Filled with particles on a lattice of the scene's spacing"),
-                       vec3("velocity", "Initial velocity").in("m/s").def({0.0, 0.0, 0.0}),
-                       number("temperature", "Initial temperature; default ambient.temperature")
-                           .in("°C")
-                           .above(-273.15)
-                           .at_most(3000)
-                           .optional(),
-                   },
-                   "Blocks of fluid particles.")
+                       "Filled with particles on a lattice of the scene's spacing",
+                       {
+                           vec3("velocity", "Initial velocity").in("m/s").def({0.0, 0.0, 0.0}),
+                           number("temperature", "Initial temperature; default ambient.temperature")
+                               .in("°C")
+                               .above(-273.15)
+                               .at_most(3000)
+                               .optional(),
+                       }),
+                   "Bodies of fluid particles (lattice points inside solids, ice or earlier fluid are left "
+                   "out).")
               .def(Json::array()),
           object(
               "air",

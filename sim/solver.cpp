@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <sstream>
 
 #include "sim/cl_grid.h"
@@ -124,6 +125,13 @@ SolverConstants derive_constants(const Scene& scene) {
       if (d.model == DryerModel::Air) v_ref = std::max(v_ref, d.speed);
     v_ref = std::max(v_ref, 0.1);  // a still fluid in zero gravity still needs a finite stiffness
   }
+  // Tension's pair forces pull bulk water in with a cohesive pressure p_c that the equation of state holds:
+  // the stiffness must dwarf it as it does the flow's dynamic pressure, so v_ref is at least sqrt(2 p_c /
+  // rho0) (measured: iwasaki2010 drops of R = 10 spacings blew up in 65 steps at c = 10 sqrt(2 sigma / (rho
+  // R))).
+  if (scene.tension.enabled())
+    v_ref =
+        std::max(v_ref, std::sqrt(2.0 * tension_coefficients(scene, k).cohesive_pressure / k.rest_density));
   k.sound_speed = static_cast<float>(s.speed_of_sound > 0 ? s.speed_of_sound : s.sound_speed_factor * v_ref);
   k.max_speed = static_cast<float>(s.max_speed > 0 ? s.max_speed : 5.0 * k.sound_speed);
   const float h = k.smoothing;
@@ -141,6 +149,10 @@ SolverConstants derive_constants(const Scene& scene) {
   k.repulsion = static_cast<float>(c_push * c_push / (dx * dx * k.rest_density * dx * dx * dx));
   k.repulsion_range = static_cast<float>(0.95 * dx);
   k.repulsion_damping = static_cast<float>(dx / c_push);
+  k.capillary_dt =
+      scene.tension.enabled()
+          ? std::sqrt(k.rest_density * dx * dx * dx / (2.0 * std::numbers::pi * scene.tension.coefficient))
+          : std::numeric_limits<double>::infinity();
 
   const double inf = std::numeric_limits<double>::infinity();
   const double alpha = max_diffusivity(scene);
@@ -305,6 +317,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
 
   // The stages this scene needs, each declaring its fields; then the fields are allocated and filled.
   rigid_.reset();
+  tension_.reset();
   surface_.reset();
   surface_done_ = false;
   heat_.reset();
@@ -322,6 +335,8 @@ void Solver::build(const SimState& st, std::size_t capacity) {
     dfsph_ =
         std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow(), plan.build);
   if (dfsph_) fluid_->compute_dfsph_alpha(dfsph_->columns(), dfsph_->min_neighbours());
+  if (fluid_ && scene_.tension.enabled())
+    tension_ = std::make_unique<TensionStage>(cl_, store_, f_, scene_, k_, opts, layout_);
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
   if (rigid_ && fluid_ && dfsph_ && scene_.multiphase())
     rigid_->use_multiphase(fluid_->flow(), dfsph_->columns(), layout_.stride);
@@ -572,6 +587,7 @@ double Solver::choose_time_step() {
   // a plane Poiseuille flow up in 160 steps at 0.125 h^2 / nu; 0.05 h^2 / nu ran).
   const double hv = std::min(double(h), scene_.spacing);
   if (k_.kinematic_viscosity > 0) dt = std::min(dt, s.viscous_number * hv * hv / k_.kinematic_viscosity);
+  if (tension_) dt = std::min(dt, k_.capillary_dt);
   // Conduction's limit, or as many of it as heat.max_substeps lets one flow step hold (compute_heat).
   const double dt_heat = heat_time_step() * scene_.heat.max_substeps;
   dt = std::min(dt, dt_heat);
@@ -644,6 +660,7 @@ void Solver::step() {
   if (flow) {
     timed(Stage::Density, [&] { compute_density(); });
     timed(Stage::Forces, [&] { compute_forces(); });
+    if (tension_) timed(Stage::Tension, [&] { tension_->run(neighbours(), fluid_->accel()); });
   }
   if (rigid_) timed(Stage::IceForces, [&] { rigid_->compute_forces(buffers()); });
   double dt = 0;
@@ -677,6 +694,7 @@ void Solver::step_dfsph() {
     if (rigid_ && n_ > 0)
       cl_.queue().enqueueCopyBuffer(store_[f_.velocity], forces_velocity_, 0, 0, n_ * sizeof(cl_float4));
   });
+  if (tension_) timed(Stage::Tension, [&] { tension_->run(neighbours(), fluid_->accel()); });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
   if (heat_) heat_stages(dt);
@@ -716,6 +734,7 @@ void Solver::warm_up() {
   if (rigid_) rigid_->relabel_if_due(buffers(), steps_);
   compute_density();
   compute_forces();
+  if (tension_) tension_->run(neighbours(), fluid_->accel());
   if (rigid_) rigid_->compute_forces(buffers());
   choose_time_step();
   integrate(0.0);
@@ -774,6 +793,7 @@ bool Solver::set_emitter(std::size_t index, const Emitter& e) {
 std::vector<std::string> Solver::stages() const {
   std::vector<std::string> out = {"grid"};
   if (fluid_) out.insert(out.end(), {"density", "forces"});
+  if (tension_) out.push_back(std::string("tension (") + name(scene_.tension.model) + ")");
   // A newcomer sees which form holds air beside water (the same solve, other passes).
   if (dfsph_)
     out.push_back(scene_.multiphase()

@@ -22,6 +22,7 @@
 #include "sim/stage_timers.h"
 #include "sim/state_file.h"
 #include "sim/surface_stage.h"
+#include "sim/tension_stage.h"
 
 namespace thaw {
 
@@ -41,6 +42,9 @@ struct SolverConstants {
   // stiffness m_i m_b repulsion [1/(kg s^2)] = c^2 / (dx^2 rho0 dx^3), as stiff as the ice contacts, with
   // a dashpot of time repulsion_damping = dx / c [s] (forces.cl).
   float repulsion = 0, repulsion_range = 0, repulsion_damping = 0;
+  // Tension's capillary limit on dt, sqrt(rho0 dx^3 / (2 pi sigma)) (Brackbill et al. 1992) [s]; infinite
+  // without tension.
+  double capillary_dt = 0;
   // Heat: the diffusion limit on dt [s] (infinite without conduction), and the smallest heat capacity
   // per exposed area rho c dx / 6 over the materials that exchange heat with the air [J/m^2/K].
   double diffusion_dt = 0;
@@ -235,6 +239,7 @@ class Solver {
   // whatever is built; the thermal table gives the masses its enthalpy sum needs.
   std::unique_ptr<HeatStage> heat_;
   std::unique_ptr<SurfaceStage> surface_;  // only when heat_ takes its exposed areas from it
+  std::unique_ptr<TensionStage> tension_;  // only with flow and tension.model other than none
   bool surface_done_ = false;              // without flow the particles never move: one pass serves the run
   std::string heat_reason_;
   std::vector<Float2> fixed_enthalpy_;

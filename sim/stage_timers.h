@@ -11,11 +11,13 @@ namespace thaw {
 // and labelling, per-body sums, rigid integration and placing the ice particles. Emit runs only in scenes
 // with emitters (sim/emitters.h), and includes growing the capacity. Pressure runs only with DFSPH
 // (sim/dfsph_stage.h): alpha, the divergence and density solves, and the predicted velocities. Surface runs
-// only where the heat stage takes its exposed areas from it (sim/surface_stage.h).
+// only where the heat stage takes its exposed areas from it (sim/surface_stage.h); Tension only with
+// tension.model (sim/tension_stage.h), after Forces.
 enum class Stage {
   Grid,
   Density,
   Forces,
+  Tension,
   Pressure,
   IceForces,
   TimeStep,
@@ -28,8 +30,8 @@ enum class Stage {
   Count
 };
 inline constexpr std::array<const char*, static_cast<int>(Stage::Count)> kStageNames = {
-    "grid",    "density", "forces", "pressure", "ice_forces", "time_step",
-    "photons", "surface", "heat",   "bodies",   "integrate",  "emit"};
+    "grid",    "density", "forces", "tension", "pressure",  "ice_forces", "time_step",
+    "photons", "surface", "heat",   "bodies",  "integrate", "emit"};
 
 class StageTimers {
  public:

@@ -196,7 +196,9 @@ kernel void density(global const float4* pos, global const float* soa, global co
   /* Linear: p = c^2 (rho - rho0), B passed as c^2 * rho0. */
   float p = B * (rho / rho0 - 1.0f);
 #endif
-  /* No tension: clamping keeps free-surface particles from clumping (tensile instability). */
+  /* Clamped at zero: negative pressure would make free-surface particles clump (tensile instability).
+   * Surface tension (tension.cl) is an explicit force, not a negative pressure, so the clamp leaves it whole;
+   * its pull on the bulk is held by positive pressure (sim/tension_stage.h, cohesive_pressure). */
   p = fmax(p, 0.0f);
   const float dp = p / (rho * rho);
   density[i] = rho;

@@ -58,6 +58,8 @@ ValidationCase air_sphere_case();
 ValidationCase air_water_case();
 ValidationCase surface_area_case();
 ValidationCase ambient_sphere_case();
+ValidationCase laplace_case();
+ValidationCase drop_oscillation_case();
 
 // A scene of ice held in still air, for the surface cases (sim/validation/surface_area.cpp): the cube
 // [-half, half]^3 at spacing dx without gravity, the ambient at air_temperature through h, heat.exposed_area

@@ -75,6 +75,12 @@ TEST_F(KernelBuild, EveryEmbeddedStageBuilds) {
         {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h", "surface_params.h", "surface.cl"},
         std::string("-DTHAW_REACH=1 -DTHAW_VW=8 ") + model))
         << model;
+  // The tension stage, both models (sim/tension_stage.cpp).
+  for (const char* model : {"-DTHAW_TENSION_AKINCI2013", "-DTHAW_TENSION_IWASAKI2010"})
+    EXPECT_NO_THROW(
+        cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "tension_params.h", "tension.cl"},
+                   std::string("-DTHAW_REACH=1 -DTHAW_VW=8 ") + model))
+        << model;
 }
 
 // NVIDIA's compiler ignores #line and counts lines of the joined source ("<kernel>:12:5"); the message
@@ -119,6 +125,9 @@ TEST_F(KernelBuild, EveryProgramIsPortableOpenClC) {
   variants.push_back({"dam-break", {"solver.kernel=wendland_c2", "solver.support_ratio=3"}});
   variants.push_back(
       {"ice-on-plate", {"domain.walls=[]", "solver.flow=false", "solver.periodic=[\"x\",\"y\"]"}});
+  // Tension, both models.
+  variants.push_back({"ice-on-plate", {"tension.model=akinci2013"}});
+  variants.push_back({"ice-on-plate", {"tension.model=iwasaki2010", "solver.pressure=dfsph"}});
   // Air beside the meltwater: the multiphase passes (both models), eq 8's buoyancy, and room air through an
   // open top.
   const std::string air_material =

@@ -169,6 +169,25 @@ TEST(Scene, ConvertsEveryField) {
   EXPECT_EQ(s.domain.max, Eigen::Vector3d(0.4, 0.2, 0.3));
 }
 
+// A fluid body may be any shape ice can be: a sphere of water (a drop) holds its volume in particles, a
+// box written without a shape is still a box, and a sphere without a radius is refused at its path.
+TEST(Scene, FluidBodiesTakeShapes) {
+  Json doc = base_scene();
+  doc["fluids"][1] = {
+      {"material", "water"}, {"shape", "sphere"}, {"centre", {0.3, 0.1, 0.15}}, {"radius", 0.05}};
+  const Scene scene = scene_from_json(doc);
+  ASSERT_EQ(scene.fluids.size(), 2u);
+  EXPECT_TRUE(scene.fluids[0].shape.axis_aligned_box());
+  const HostParticles p = initial_state(scene).particles;
+  std::size_t drop = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.phase[i] == std::uint8_t(Phase::Water) && p.position[i][0] > 0.24) ++drop;
+  // 552 lattice points at R = 5 spacings: the sphere's volume within the lattice's rounding.
+  EXPECT_NEAR(double(drop) * 1e-6, 4.0 / 3.0 * M_PI * 0.05 * 0.05 * 0.05, 0.08 * 5.24e-4);
+  doc["fluids"][1].erase("radius");
+  EXPECT_EQ(scene_error(doc).path(), "fluids[1].radius");
+}
+
 TEST(Scene, NoWallsNeedNoWallMaterial) {
   Json doc = base_scene();
   doc["domain"].erase("wall_material");

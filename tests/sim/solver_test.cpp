@@ -450,6 +450,7 @@ TEST_F(SolverTest, FlowPropertiesArePerMaterialAndTwoRestDensitiesNeedDfsph) {
   second.material = syrup;
   second.box.min.z() = second.box.max.z() + 0.1;
   second.box.max.z() = second.box.min.z() + 0.1;
+  second.shape = Shape::box(second.box.min, second.box.max);
   scene.fluids.push_back(second);
   const SolverConstants k = derive_constants(scene);
   EXPECT_FLOAT_EQ(k.kinematic_viscosity, 0.5f / 1000.0f) << "the most viscous fluid sets the viscous limit";

@@ -1,0 +1,49 @@
+/* The tension passes' parameters, shared verbatim by the host (sim/tension_stage.cpp) and tension.cl; every
+ * member is 4 bytes, so both layouts agree (static_assert below). On the host also Akinci et al. 2013's two
+ * kernel shapes, which sim/tension_stage.cpp integrates to calibrate the coefficients (tension.cl has them
+ * on lanes; a test holds the two to each other through the calibration). */
+#ifndef THAW_TENSION_PARAMS_H
+#define THAW_TENSION_PARAMS_H
+
+#ifdef __OPENCL_VERSION__
+#define THAW_TENSION_FN
+#else
+#include <cmath>
+#define THAW_TENSION_FN inline
+namespace thaw::tension {
+using std::fmax;
+using std::pow;
+using std::sqrt;
+#endif
+
+typedef struct {
+  float support;      /* kernel support H [m] */
+  float rest_density; /* rho0 of water [kg/m^3]: Akinci's K_ij = 2 rho0 / (rho_i + rho_j) */
+  /* akinci2013: gamma of eqs. 1-2 (the same number scales eq. 2); iwasaki2010: k_w of eq. 4 [N m] */
+  float cohesion;
+  float curvature; /* 1: akinci2013's curvature term (eq. 2); 0: not */
+  unsigned int n;
+  unsigned int stride;
+  unsigned int pad0, pad1;
+} TensionParams;
+
+#ifndef __OPENCL_VERSION__
+/* Akinci et al. 2013 eq. 3 (their C(r)) on support H, with q = r / H: 32 / (pi H^3) c(q), where
+ * c = (1 - q)^3 q^3 for 1/2 < q <= 1 and 2 (1 - q)^3 q^3 - 1/64 for 0 < q <= 1/2: attraction past H/2,
+ * repulsion close in. */
+inline double akinci_cohesion_shape(double q) {
+  const double a = (1.0 - q) * (1.0 - q) * (1.0 - q) * q * q * q;
+  return q > 1.0 ? 0.0 : (q > 0.5 ? a : 2.0 * a - 1.0 / 64.0);
+}
+
+/* Akinci et al. 2013 eq. 7 (their A(r)) on support H, with q = r / H: 0.007 / H^3 a(q), where
+ * a = (-4 q^2 + 6 q - 2)^(1/4) for 1/2 < q <= 1, else 0. */
+inline double akinci_adhesion_shape(double q) {
+  return (q > 0.5 && q <= 1.0) ? std::pow(std::max(-4.0 * q * q + 6.0 * q - 2.0, 0.0), 0.25) : 0.0;
+}
+
+static_assert(sizeof(TensionParams) == 32, "TensionParams must match its OpenCL layout");
+}  // namespace thaw::tension
+#endif
+
+#endif

@@ -1,0 +1,118 @@
+#include "sim/tension_stage.h"
+
+#include <cctype>
+#include <cmath>
+#include <numbers>
+
+#include "sim/cl_launch.h"
+#include "sim/solver.h"
+
+namespace thaw {
+
+namespace {
+
+constexpr std::size_t kColumns = 7;  // tension.cl's column block: W, R, V, B, NX, NY, NZ
+
+// int_0^1 q^p f(q) dq by Simpson's rule on 2000 intervals per half (the shapes have a kink at q = 1/2).
+double moment(double (*f)(double), int p) {
+  const int n = 2000;
+  double sum = 0;
+  for (double a : {0.0, 0.5}) {
+    const double h = 0.5 / n;
+    for (int i = 0; i <= n; ++i) {
+      const double q = a + i * h;
+      // The shapes' value just inside each half, so the kink at 1/2 is taken from the right side.
+      const double x = i == 0 && a > 0 ? q + 1e-12 : (i == n && a == 0 ? q - 1e-12 : q);
+      const double w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
+      sum += w * std::pow(x, p) * f(x) * h / 3;
+    }
+  }
+  return sum;
+}
+
+double deg(double angle) { return angle * std::numbers::pi / 180.0; }
+
+}  // namespace
+
+TensionCoefficients tension_coefficients(const Scene& scene, const SolverConstants& k) {
+  const TensionSettings& t = scene.tension;
+  const double H = k.support, rho0 = k.rest_density, dx = scene.spacing, pi = std::numbers::pi;
+  const double sigma = t.coefficient;
+  TensionCoefficients out;
+  out.adhesion.assign(scene.materials.size(), 0.0f);
+  // Per unit of the adhesion weight: the work of adhesion the pair force gives a water-solid face.
+  // f(r) = beta m_i Psi_b A(r), n_f m_i = rho0 = n_s Psi_b: W = (pi / 4) rho0^2 beta int r^4 A.
+  double adhesion_per_weight =
+      pi / 4.0 * rho0 * rho0 * 0.007 * H * H * moment(tension::akinci_adhesion_shape, 4);
+  if (t.model == TensionModel::Akinci2013) {
+    // f(r) = gamma m_i m_j C(r): sigma = (pi / 8) rho0^2 gamma int r^4 C, C = 32 / (pi H^3) c(r / H).
+    const double c4 = 32.0 / pi * H * H * moment(tension::akinci_cohesion_shape, 4);
+    out.cohesion = 8.0 * sigma / (pi * rho0 * rho0 * c4);
+    out.cohesive_pressure = 2.0 * pi / 3.0 * rho0 * rho0 * out.cohesion * 32.0 / pi * H *
+                            moment(tension::akinci_cohesion_shape, 3);
+  } else if (t.model == TensionModel::Iwasaki2010) {
+    // f(r) = k / r between particles of number density 1 / dx^3: sigma = pi n^2 k H^4 / 32, and
+    // W = (pi / 4) n^2 k H^4 / 4 against a solid.
+    const double n = 1.0 / (dx * dx * dx);
+    out.cohesion = 32.0 * sigma / (pi * n * n * std::pow(H, 4));
+    out.cohesive_pressure = 2.0 * pi / 3.0 * n * n * out.cohesion * std::pow(H, 3) / 3.0;
+    adhesion_per_weight = pi / 4.0 * n * n * std::pow(H, 4) / 4.0;
+  }
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    const MaterialKind kind = scene.materials[m].kind;
+    if (kind != MaterialKind::Solid && kind != MaterialKind::Ice) continue;
+    const double angle = kind == MaterialKind::Ice ? t.ice_contact_angle : t.solid_contact_angle;
+    out.adhesion[m] = static_cast<float>(sigma * (1.0 + std::cos(deg(angle))) / adhesion_per_weight);
+  }
+  return out;
+}
+
+TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
+                           const SolverConstants& k, const std::string& build_options,
+                           const ParticleLayout& layout)
+    : cl_(cl), store_(store), core_(core), layout_(layout), model_(scene.tension.model) {
+  std::string opts = build_options + " -DTHAW_TENSION_";
+  for (const char* c = name(model_); *c; ++c) opts += static_cast<char>(std::toupper(*c));
+  // Adhesion only where water can meet solids or ice.
+  if (!scene.walls.empty() || !scene.solids.empty() || !scene.ice.empty()) opts += " -DTHAW_TENSION_ADHESION";
+  const auto program =
+      cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "tension_params.h", "tension.cl"}, opts);
+  k_columns_ = cl::Kernel(program, "tension_columns");
+  if (model_ == TensionModel::Akinci2013) k_normals_ = cl::Kernel(program, "tension_normals");
+  k_forces_ = cl::Kernel(program, "tension_forces");
+
+  const TensionCoefficients c = tension_coefficients(scene, k);
+  params_.support = k.support;
+  params_.rest_density = k.rest_density;
+  params_.cohesion = static_cast<float>(c.cohesion);
+  params_.curvature = scene.tension.curvature ? 1.0f : 0.0f;
+  params_.stride = layout.stride;
+  std::vector<float> adhesion = c.adhesion;
+  if (adhesion.empty()) adhesion.push_back(0.0f);
+  adhesion_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                         adhesion.size() * sizeof(float), adhesion.data());
+  const std::size_t bytes = std::size_t(layout.stride) * kColumns * sizeof(float);
+  columns_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, bytes);
+  cl.queue().enqueueFillBuffer(columns_, 0.0f, 0, bytes);
+}
+
+void TensionStage::run(const NeighbourView& nv, const cl::Buffer& accel) {
+  if (layout_.n == 0) return;
+  tension::TensionParams P = params_;
+  P.n = static_cast<cl_uint>(layout_.n);
+  P.stride = nv.stride;
+  auto& q = cl_.queue();
+  set_args(k_columns_, store_[core_.phase], store_[core_.material], store_[core_.position],
+           store_[core_.density], adhesion_, P, columns_);
+  launch(q, k_columns_, nv.stride);
+  if (model_ == TensionModel::Akinci2013) {
+    set_args(k_normals_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
+             columns_);
+    launch(q, k_normals_, layout_.n);
+  }
+  set_args(k_forces_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
+           columns_, accel);
+  launch(q, k_forces_, layout_.n);
+}
+
+}  // namespace thaw

@@ -1,0 +1,158 @@
+// The tension stage (sim/tension_stage.h): its calibration from sigma and the contact angles, that it is
+// built only when a scene asks for it, that its pair forces move no momentum, and that tension pulls a long
+// block of water round with WCSPH and with DFSPH while without it the block keeps its shape.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "sim/solver.h"
+#include "sim/tension_stage.h"
+#include "tests/test_support.h"
+
+namespace thaw {
+namespace {
+
+using testing::ClSuite;
+
+class TensionTest : public ClSuite {};
+
+// A block of water 2 cm long and 1 cm across without gravity, at 1 mm; `tension` is the scene's block.
+Json block_scene(const Json& tension, const std::string& pressure = "wcsph") {
+  Json doc = Json::parse(R"({
+    "name": "tension-test", "domain": {"min": [-0.02, -0.02, -0.02], "max": [0.02, 0.02, 0.02]},
+    "gravity": [0, 0, 0], "spacing": 0.001, "heat": {"enabled": false},
+    "solver": {"reference_speed": 0.2, "max_dt": 2e-4},
+    "materials": {"water": {"kind": "fluid", "density": 1000, "viscosity": 0.0018, "conductivity": 0.56,
+                            "specific_heat": 4200}},
+    "fluids": [{"material": "water", "box": {"min": [-0.005, -0.005, -0.01], "max": [0.005, 0.005, 0.01]}}]
+  })");
+  doc["tension"] = tension;
+  doc["solver"]["pressure"] = pressure;
+  return doc;
+}
+
+// mean (z^2 - (x^2 + y^2) / 2) about the centre of mass: 0 for a sphere, positive for a block long in z.
+double elongation(const HostParticles& p) {
+  double c[3] = {0, 0, 0};
+  for (const auto& x : p.position)
+    for (int a = 0; a < 3; ++a) c[a] += x[a];
+  for (double& v : c) v /= double(p.size());
+  double q = 0;
+  for (const auto& x : p.position) {
+    const double dx = x[0] - c[0], dy = x[1] - c[1], dz = x[2] - c[2];
+    q += dz * dz - 0.5 * (dx * dx + dy * dy);
+  }
+  return q / double(p.size());
+}
+
+TEST(TensionCalibration, FollowsKirkwoodBuffAndYoungDupre) {
+  Json doc = block_scene({{"model", "iwasaki2010"}, {"coefficient", 0.07}});
+  doc["materials"]["steel"] = {
+      {"kind", "solid"}, {"density", 7800}, {"conductivity", 16}, {"specific_heat", 500}};
+  doc["materials"]["ice"] = {{"kind", "ice"},
+                             {"density", 917},
+                             {"conductivity", 2.22},
+                             {"specific_heat", 2050},
+                             {"melts_into", "water"}};
+  doc["solids"] = {{{"shape", "box"},
+                    {"material", "steel"},
+                    {"box", {{"min", {-0.02, -0.02, -0.02}}, {"max", {0.02, 0.02, -0.018}}}}}};
+  auto coefficients = [&](const Json& d) {
+    const Scene s = scene_from_json(d);
+    return std::pair{s, tension_coefficients(s, derive_constants(s))};
+  };
+  auto index = [](const Scene& s, const std::string& name) {
+    for (std::size_t m = 0; m < s.materials.size(); ++m)
+      if (s.materials[m].name == name) return m;
+    return s.materials.size();
+  };
+  // Iwasaki's k / r between particles of number density n = 1 / dx^3: sigma = pi n^2 k H^4 / 32.
+  const auto [scene, c] = coefficients(doc);
+  const double n = 1e9, H = 0.002, pi = std::numbers::pi;
+  EXPECT_NEAR(c.cohesion, 32 * 0.07 / (pi * n * n * std::pow(H, 4)), 1e-6 * c.cohesion);
+  // The water against a solid: W = sigma (1 + cos theta) = pi n^2 k_s H^4 / 16, at the defaults 90° (steel)
+  // and 12° (ice); fluids have none.
+  EXPECT_NEAR(c.adhesion[index(scene, "steel")], 16 * 0.07 / (pi * n * n * std::pow(H, 4)),
+              1e-5 * c.cohesion);
+  EXPECT_NEAR(c.adhesion[index(scene, "ice")] / c.adhesion[index(scene, "steel")],
+              1 + std::cos(12 * pi / 180), 1e-5);
+  EXPECT_EQ(c.adhesion[index(scene, "water")], 0.0f);
+  // No adhesion at 180°.
+  Json dry = doc;
+  dry["tension"]["solid_contact_angle"] = 180;
+  EXPECT_NEAR(coefficients(dry).second.adhesion[index(scene, "steel")], 0.0f, 1e-6 * c.cohesion);
+  // Akinci's gamma: sigma = (pi / 8) rho0^2 gamma int r^4 C, with C scaling as 1 / H^3: gamma goes as
+  // sigma / H^2 and is the same for adhesion at the same angle whatever the resolution in H units.
+  Json a = doc;
+  a["tension"]["model"] = "akinci2013";
+  const TensionCoefficients fine = coefficients(a).second;
+  a["spacing"] = 0.002;
+  a["tension"]["coefficient"] = 0.14;
+  const TensionCoefficients coarse = coefficients(a).second;
+  EXPECT_NEAR(coarse.cohesion / fine.cohesion, 2.0 / 4.0, 1e-6);
+  EXPECT_GT(fine.adhesion[index(scene, "steel")], 0.0f);
+}
+
+TEST_F(TensionTest, TheStageIsBuiltOnlyWhenTheSceneHasTension) {
+  auto stages = [&](const Json& doc) {
+    const Scene scene = scene_from_json(doc);
+    Solver s(cl(), scene, initial_state(scene));
+    std::string all;
+    for (const std::string& x : s.stages()) all += x + ",";
+    return all;
+  };
+  EXPECT_EQ(stages(block_scene({{"model", "none"}})).find("tension"), std::string::npos);
+  EXPECT_NE(stages(block_scene({{"model", "akinci2013"}})).find("tension (akinci2013)"), std::string::npos);
+  EXPECT_NE(stages(block_scene({{"model", "iwasaki2010"}}, "dfsph")).find("tension (iwasaki2010)"),
+            std::string::npos);
+  // Without flow nothing moves: no tension pass.
+  Json still = block_scene({{"model", "akinci2013"}});
+  still["solver"]["flow"] = false;
+  still["heat"]["enabled"] = true;
+  still["fluids"][0]["temperature"] = 30;
+  EXPECT_EQ(stages(still).find("tension"), std::string::npos);
+}
+
+// Pairwise and antisymmetric between particles of one mass: the water's total momentum stays at its start
+// (0) while the block pulls itself in.
+TEST_F(TensionTest, ThePairForcesMoveNoMomentum) {
+  for (const char* model : {"akinci2013", "iwasaki2010"}) {
+    const Scene scene = scene_from_json(block_scene({{"model", model}}, "dfsph"));
+    Solver s(cl(), scene, initial_state(scene));
+    for (int k = 0; k < 60; ++k) s.step();
+    const HostParticles p = s.particles();
+    double momentum[3] = {0, 0, 0}, scale = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double m = p.position[i][3];
+      for (int a = 0; a < 3; ++a) momentum[a] += m * p.velocity[i][a];
+      scale += m * std::sqrt(p.velocity[i][0] * p.velocity[i][0] + p.velocity[i][1] * p.velocity[i][1] +
+                             p.velocity[i][2] * p.velocity[i][2]);
+    }
+    ASSERT_GT(scale, 0) << model << ": the tension moved nothing";
+    EXPECT_LT(std::hypot(momentum[0], momentum[1], momentum[2]) / scale, 1e-4) << model;
+  }
+}
+
+// A block twice as long as it is wide, without gravity: tension pulls it towards a sphere (its elongation
+// falls by more than half in 0.1 s, about a capillary time) with either pressure solver, and without
+// tension it keeps its shape.
+TEST_F(TensionTest, TensionPullsALongBlockRound) {
+  for (const char* pressure : {"wcsph", "dfsph"})
+    for (const char* model : {"none", "akinci2013"}) {
+      const Scene scene = scene_from_json(block_scene({{"model", model}}, pressure));
+      SimState st = initial_state(scene);
+      const double start = elongation(st.particles);
+      ASSERT_GT(start, 0);
+      Solver s(cl(), scene, st);
+      while (s.time() < 0.1) s.step();
+      const double end = elongation(s.particles());
+      if (std::string(model) == "none")
+        EXPECT_NEAR(end / start, 1.0, 0.05) << pressure;
+      else
+        EXPECT_LT(end / start, 0.5) << pressure;
+    }
+}
+
+}  // namespace
+}  // namespace thaw
