@@ -218,6 +218,13 @@ void RigidIce::relabel_if_due(const ParticleBuffers& p, std::uint64_t step, bool
   ++labellings_;
 }
 
+void RigidIce::use_tension(const std::vector<float>& adhesion) {
+  std::vector<float> table = adhesion;
+  if (table.empty()) table.push_back(0.0f);
+  adhesion_ = cl::Buffer(cl_.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(float),
+                         table.data());
+}
+
 void RigidIce::compute_forces(const ParticleBuffers& p) {
   const ContactModel& c = settings_.contact;
   const ClContact contact{float(c.stiffness), float(c.damping), float(c.friction), float(c.distance)};
@@ -231,6 +238,11 @@ void RigidIce::compute_forces(const ParticleBuffers& p) {
     k_forces_.setArg(16, *flow_);
     k_forces_.setArg(17, *columns_);
     k_forces_.setArg(18, columns_stride_);
+  }
+  if (adhesion_()) {  // after the multiphase arguments where there are any
+    const cl_uint at = flow_ ? 19 : 15;
+    k_forces_.setArg(at, p.material);
+    k_forces_.setArg(at + 1, adhesion_);
   }
   launch(cl_.queue(), k_forces_, p.n);
 }

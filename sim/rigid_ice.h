@@ -100,6 +100,9 @@ class RigidIce {
     columns_ = &columns;
     columns_stride_ = stride;
   }
+  // Builds with THAW_TENSION_REACTION: each material's adhesion coefficient (tension_coefficients in
+  // sim/tension_stage.h), so the ice takes the reaction of the water's adhesion to it.
+  void use_tension(const std::vector<float>& adhesion);
   // The fastest point of any free body [m/s] (the time step's CFL limit covers it).
   double max_point_speed() const;
   // Sums the forces per body, integrates the bodies over dt and moves their particles.
@@ -142,6 +145,7 @@ class RigidIce {
   cl::Kernel k_forces_, k_place_;
   ParticleStore::Field body_ = 0, offset_ = 0;
   cl::Buffer force_, label_, bodies_dev_, refs_;
+  cl::Buffer adhesion_;               // use_tension
   const cl::Buffer* flow_ = nullptr;  // use_multiphase
   const cl::Buffer* columns_ = nullptr;
   std::uint32_t columns_stride_ = 0;

@@ -272,8 +272,17 @@ std::unique_ptr<RigidIce> make_rigid_ice(ClRuntime& cl, ParticleStore& store, co
   std::vector<std::uint8_t> anchored_by_id(ids, 0);
   for (std::size_t i = 0; i < p.size() && i < p.anchored.size(); ++i)
     if (p.id[i] < ids) anchored_by_id[p.id[i]] = p.anchored[i];
-  return std::make_unique<RigidIce>(cl, store, opts, capacity, rigid_settings(scene, k),
-                                    std::move(anchored_by_id), rigid_mass_scales(scene, k.rest_density));
+  // With tension the ice takes the reaction of the water's adhesion to it (rigid.cl, tension.cl).
+  std::string options = opts;
+  if (scene.tension.enabled())
+    options += scene.tension.model == TensionModel::Akinci2013
+                   ? " -DTHAW_TENSION_REACTION -DTHAW_TENSION_AKINCI2013"
+                   : " -DTHAW_TENSION_REACTION -DTHAW_TENSION_IWASAKI2010";
+  auto rigid =
+      std::make_unique<RigidIce>(cl, store, options, capacity, rigid_settings(scene, k),
+                                 std::move(anchored_by_id), rigid_mass_scales(scene, k.rest_density));
+  if (scene.tension.enabled()) rigid->use_tension(tension_coefficients(scene, k).adhesion);
+  return rigid;
 }
 
 // Room for the emitters' first second, and a layer of room air, beside the particles there are; the solver

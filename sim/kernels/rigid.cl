@@ -45,6 +45,10 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
                          global const uchar* material, global const MaterialFlow* flow, global const float* col,
                          const uint stride
 #endif
+#ifdef THAW_TENSION_REACTION
+                         ,
+                         global const uchar* tension_material, global const float* adhesion
+#endif
 ) {
   const uint i = get_global_id(0);
   if (i >= n) return;
@@ -61,6 +65,12 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
   const float d2 = contact.distance * contact.distance;
   const int4 c = grid_cell(g, pi);
   float3 f_fluid = (float3)(0.0f), f_contact = (float3)(0.0f);
+#ifdef THAW_TENSION_REACTION
+  /* The water's adhesion to this ice particle (tension.cl), taken back: Akinci et al. 2013 eq 6's
+   * beta m_j Psi_b A(r) x_bj / r towards the water (Psi_b = pi.w, applied with f_fluid below), or Iwasaki's
+   * k_b x_bj / r^2. */
+  const float adhesion_b = adhesion[tension_material[i]];
+#endif
   FOR_EACH_NEIGHBOUR(g, cell_start, c, j) {
     if (j == i) continue;
     const float3 x = pi.xyz - pos[j].xyz;
@@ -87,6 +97,18 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
       const float s = visc_boundary * mj * (rho0 / (rho_i * sj.x)) * vd / (r2 + eps2) - mj * (dpi + sj.y);
 #endif
       f_fluid += s * KERNEL_GRAD(sqrt(r2), H) * x;
+#ifdef THAW_TENSION_REACTION
+      if (pj == THAW_PHASE_WATER) {
+        const float r = sqrt(r2);
+#ifdef THAW_TENSION_AKINCI2013
+        const float q = r / H;
+        const float a = (q > 0.5f && q <= 1.0f) ? sqrt(sqrt(fmax(-4.0f * q * q + 6.0f * q - 2.0f, 0.0f))) : 0.0f;
+        f_fluid -= adhesion_b * mj * 0.007f / (H * H * H) * a / fmax(r, 1e-12f) * x;
+#else
+        f_contact -= adhesion_b / fmax(r2, 1e-24f) * x;
+#endif
+      }
+#endif
     } else if (r2 < d2 && (pj == THAW_PHASE_SOLID || (pj == THAW_PHASE_ICE && body[j] != b))) {
       const float r = sqrt(r2);
       const float3 normal = x / fmax(r, 1e-12f);
