@@ -90,6 +90,7 @@ Json Service::scene_state() const {
           {"camera", camera_json(o)},
           {"speed", stats ? stats->value("speed", 0.0) : 0.0},
           {"heat_time_scale", scene->heat.time_scale},
+          {"tension", name(scene->tension.model)},
           {"paused", stats ? stats->value("paused", false) : false}};
 }
 

@@ -723,9 +723,13 @@ void Session::publish() {
   if (window_steps > 0) last_step_ms_ = 1e3 * window_step_seconds_ / double(window_steps);
 
   std::shared_ptr<const RenderSnapshot> snapshot;
-  Json stats = {{"type", "stats"},          {"scene", scene_.name},
-                {"time", solver_->time()},  {"steps", steps},
-                {"generation", generation_}, {"heat_time_scale", scene_.heat.time_scale}};
+  Json stats = {{"type", "stats"},
+                {"scene", scene_.name},
+                {"time", solver_->time()},
+                {"steps", steps},
+                {"generation", generation_},
+                {"heat_time_scale", scene_.heat.time_scale},
+                {"tension", name(scene_.tension.model)}};
   try {
     // One read of the device serves the picture and the numbers.
     const HostParticles p = solver_->particles();

@@ -336,7 +336,8 @@ const Field& scene_schema() {
                       "the contact angles below, so that a flat surface of uniformly spread particles "
                       "has that tension; docs/TENSION.md has how near the simulated drops come. none: no "
                       "tension stage is built")
-                      .def("none"),
+                      .def("none")
+                      .client_settable(),
                   number("coefficient",
                          "Water-air surface tension sigma; 0.0756 at 0 °C, 0.0728 at 20 °C. A scene that "
                          "scales it says so in its description")

@@ -19,6 +19,7 @@ let paused = false;
 let dryers = [];          // the scene's dryers as the server last described them
 let lamps = [];           // its lamps
 let emitters = [];        // and its taps (emitters), with their flow in L/s
+let tension = 'none';     // the tension model in force (tension.model)
 let history = [];         // [sim time, ice fraction or null, mean temperature or null]
 let pace = [];            // [wall ms, sim time] of recent stats, for the simulated seconds per wall second
 let reconnectDelay = 500;
@@ -102,7 +103,7 @@ function applyScene(m) {
   fillSelect($('emitter'), indices(emitters), '0');
   applyLists();
   applyView(m.view, m.quality);
-  applyPace(m.speed, m.heat_time_scale);
+  applyPace(m.speed, m.heat_time_scale, m.tension);
   applyPaused(m.paused);
   history = [];
   pace = [];
@@ -151,9 +152,11 @@ function showChoice(id, value, label) {
   select.value = v;
 }
 
-function applyPace(speed, heatScale) {
+function applyPace(speed, heatScale, tensionModel) {
   showChoice('speed', speed, (v) => `${v} × real time`);
   showChoice('heat-scale', heatScale, (v) => `× ${v}`);
+  showChoice('tension', tensionModel, (v) => v);
+  if (tensionModel !== undefined) tension = tensionModel;
 }
 
 function applyPaused(p) {
@@ -205,7 +208,7 @@ function onStats(m) {
   }
   applyLists();
   applyView(m.view, m.quality);
-  applyPace(m.speed, m.heat_time_scale);
+  applyPace(m.speed, m.heat_time_scale, m.tension);
 
   const now = performance.now();
   pace.push([now, m.time]);
@@ -401,6 +404,9 @@ $('speed').addEventListener('change', (e) => send('sim.speed', { factor: Number(
 // A new heat time scale rebuilds the simulation from its particles (param.set's rebuild).
 $('heat-scale').addEventListener('change', (e) =>
   send('param.set', { path: 'heat.time_scale', value: Number(e.target.value) }));
+// So does a new tension model (docs/TENSION.md).
+$('tension').addEventListener(
+    'change', (e) => send('param.set', {path: 'tension.model', value: e.target.value}));
 
 $('dryer').addEventListener('change', showDryer);
 $('dryer-on').addEventListener('change', (e) => send('dryer.set', { dryer: currentDryer(), on: e.target.checked }));

@@ -237,7 +237,8 @@ async def scenario(call, js, until):
 // dryer; "Reset view" puts the scene's camera back (a second client's welcome says where the camera is);
 // a scene change by the select rebuilds the header and the panels (icicles-lamp has a lamp and no
 // dryer) and the lamp control switches the lamp; back in default the sliders show the new scene's
-// values, not the old page's; after a reload the page shows the quality the server has.
+// values, not the old page's, and the tension select turns tension on (the server says so); after a reload
+// the page shows the quality the server has.
 TEST(BrowserClient, ThePageFollowsTheServerAcrossScenesAndReloads) {
   ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
       << "Debian's chromium is not installed (scripts/setup)";
@@ -273,6 +274,8 @@ async def scenario(call, js, until):
     await js("{ const s = document.getElementById('scene'); s.value = 'default'; s.dispatchEvent(new Event('change')); }")
     print("back", bool(await until("document.getElementById('scene-name').textContent === 'default' && dryers.length === 1", 60)))
     print("fresh sliders", await js(value('dryer-temp')), await js("document.getElementById('dryers').hidden"))
+    await js("{ const s = document.getElementById('tension'); s.value = 'akinci2013'; s.dispatchEvent(new Event('change')); }")
+    print("tension set", bool(await until("tension === 'akinci2013'", 60)))
     await js("{ const v = document.getElementById('view-kind'); v.value = 'slice'; v.dispatchEvent(new Event('change')); }")
     await asyncio.sleep(1.5)
     await call("Page.captureScreenshot", format="png")  # the slice, its colour bar labelled in the frame
@@ -304,10 +307,11 @@ async def scenario(call, js, until):
 )py"),
                                             240, &status);
   EXPECT_EQ(status, 0) << out;
-  expect_lines(out, {"connected True", "welcome True", "sliders 70 0 1000", "dryer set True", "orbited 70.0",
-                     "reset view 30.0", "scene changed True", "panels true false 1", "lamp toggled True",
-                     "back True", "fresh sliders 70 False", "quality shown True",
-                     "moving shown True", "settled True", "detail set 0.5", "reloaded True", "screenshot True"});
+  expect_lines(
+      out, {"connected True", "welcome True", "sliders 70 0 1000", "dryer set True", "orbited 70.0",
+            "reset view 30.0", "scene changed True", "panels true false 1", "lamp toggled True", "back True",
+            "fresh sliders 70 False", "tension set True", "quality shown True", "moving shown True",
+            "settled True", "detail set 0.5", "reloaded True", "screenshot True"});
   std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
   EXPECT_TRUE(served.stop()) << served.log();
 }
