@@ -60,6 +60,7 @@ ValidationCase surface_area_case();
 ValidationCase ambient_sphere_case();
 ValidationCase laplace_case();
 ValidationCase drop_oscillation_case();
+ValidationCase contact_angle_case();
 
 // A scene of ice held in still air, for the surface cases (sim/validation/surface_area.cpp): the cube
 // [-half, half]^3 at spacing dx without gravity, the ambient at air_temperature through h, heat.exposed_area

@@ -6,6 +6,9 @@
 //     (its cohesive pressure, the same in both drops: sim/tension_stage.h), so the metric is the
 //     difference of the two, against Laplace's 2 sigma (1 / R1 - 1 / R2), each R from the drop's particles'
 //     volume N dx^3 = 4/3 pi R^3.
+//   drop-oscillation: a settled drop given mode l = 2's potential flow; the frequency of its quadrupole
+//     against Rayleigh's, its decay beside Lamb's.
+//   contact-angle: a drop on a plate at three set contact angles; the angle of its settled cap.
 #include <chrono>
 #include <cmath>
 
@@ -250,7 +253,89 @@ CaseResult oscillation(ClRuntime& cl, const Json& prm, int res) {
   return r;
 }
 
+Field contact_params() {
+  return drop_params({
+      number("small_angle", "The first contact angle set").in("deg").def(45.0).above(0).below(180),
+      number("middle_angle", "The second").in("deg").def(90.0).above(0).below(180),
+      number("large_angle", "The third").in("deg").def(135.0).above(0).below(180),
+      number("settle", "Capillary times t_c = sqrt(rho R^3 / sigma) the drop spreads, damped")
+          .def(8.0)
+          .above(0),
+      number("damping", "Velocity damping per capillary time").def(5.0).at_least(0),
+      number("angle_gate", "Gate on each angle's error").in("deg").def(10.0).above(0),
+      solver_schema(),
+  });
+}
+
+// A drop of radius R set on a plate (the domain's floor, no gravity) at tension.solid_contact_angle
+// `angle`, settled; its contact angle from the spherical cap through its height h and the radius a of its
+// footprint: tan(theta / 2) = h / a.
+double settled_angle(ClRuntime& cl, const Json& prm, double angle, double dx, CaseResult& r) {
+  const double R = prm["radius"], rho = prm["density"], sigma = prm["sigma"];
+  Json doc = drop_scene("validation/contact-angle", prm, dx);
+  const double half = 3.0 * R;
+  doc["domain"] = {{"min", {-half, -half, 0.0}},
+                   {"max", {half, half, 3.0 * R}},
+                   {"walls", {"-z"}},
+                   {"wall_material", "plate"}};
+  doc["materials"]["plate"] = {
+      {"kind", "solid"}, {"density", 2500.0}, {"conductivity", 1.0}, {"specific_heat", 840.0}};
+  doc["tension"]["solid_contact_angle"] = angle;
+  doc["fluids"][0]["centre"] = {0.0, 0.0, R + 0.5 * dx};
+  const Scene scene = scene_from_json(doc);
+  const SimState st = initial_state(scene);
+  const double tc = std::sqrt(rho * R * R * R / sigma);
+  Solver solver(cl, scene, st);
+  solver.set_velocity_damping(double(prm["damping"]) / tc);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (solver.time() < double(prm["settle"]) * tc) solver.step();
+  r.wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.steps += solver.steps();
+  const HostParticles p = solver.particles();
+  double top = 0, cx = 0, cy = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.phase[i] != std::uint8_t(Phase::Water)) continue;
+    top = std::max(top, double(p.position[i][2]));
+    cx += p.position[i][0];
+    cy += p.position[i][1];
+    ++n;
+  }
+  if (n == 0) throw Error("contact-angle: the drop has no water left");
+  r.particles += n;
+  cx /= double(n);
+  cy /= double(n);
+  // The footprint: the water within a spacing of the plate's face (z = 0).
+  double a = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.phase[i] == std::uint8_t(Phase::Water) && p.position[i][2] < dx)
+      a = std::max(a, std::hypot(p.position[i][0] - cx, p.position[i][1] - cy));
+  const double h = top + 0.5 * dx;  // particle centres sit half a spacing inside the surface
+  a += 0.5 * dx;
+  return 2.0 * std::atan2(h, a) * 180.0 / M_PI;
+}
+
+CaseResult contact(ClRuntime& cl, const Json& prm, int res) {
+  const double dx = double(prm["radius"]) / res;
+  CaseResult r;
+  for (const char* key : {"small_angle", "middle_angle", "large_angle"}) {
+    const double set = prm[key];
+    const double measured = settled_angle(cl, prm, set, dx, r);
+    r.metrics.push_back({std::string("angle_") + std::to_string(int(std::lround(set))),
+                         {measured, set, std::abs(measured - set), prm["angle_gate"]}});
+  }
+  return r;
+}
+
 }  // namespace
+
+ValidationCase contact_angle_case() {
+  return {"contact-angle",
+          "A drop without gravity on a plate at three set contact angles (tension.solid_contact_angle): "
+          "the angle of its settled cap, tan(theta / 2) = h / a, against each (gate 10°, error in "
+          "degrees); res = particles across R",
+          8, contact_params, contact};
+}
 
 ValidationCase drop_oscillation_case() {
   return {
