@@ -102,8 +102,7 @@ kernel void rigid_forces(global const float4* pos, global const float4* vel, glo
         const float r = sqrt(r2);
 #ifdef THAW_TENSION_AKINCI2013
         const float q = r / H;
-        const float a = (q > 0.5f && q <= 1.0f) ? sqrt(sqrt(fmax(-4.0f * q * q + 6.0f * q - 2.0f, 0.0f))) : 0.0f;
-        f_fluid -= adhesion_b * mj * 0.007f / (H * H * H) * a / fmax(r, 1e-12f) * x;
+        f_fluid -= adhesion_b * mj * 0.007f / (H * H * H) * THAW_AKINCI_ADHESION(q) / fmax(r, 1e-12f) * x;
 #else
         f_contact -= adhesion_b / fmax(r2, 1e-24f) * x;
 #endif

@@ -66,12 +66,6 @@ floatV akinci_cohesion_shape(const floatV q) {
   return select(select(2.0f * a - 1.0f / 64.0f, a, q > 0.5f), (floatV)(0.0f), q > 1.0f);
 }
 
-/* Akinci et al. 2013 eq. 7's A(r) = 0.007 / H^3 a(q) on lanes: (-4 q^2 + 6 q - 2)^(1/4) past H/2. */
-floatV akinci_adhesion_shape(const floatV q) {
-  const floatV a = sqrt(sqrt(fmax(-4.0f * q * q + 6.0f * q - 2.0f, 0.0f)));
-  return select((floatV)(0.0f), a, (q > 0.5f) & (q <= 1.0f));
-}
-
 /* Akinci et al. 2013 eq. 4: n_i = H sum_j (m_j / rho_j) grad W_ij over water neighbours, dimensionless and
  * about H |grad c| long at the surface, pointing into the water as SPlisHSPlasH's implementation has it
  * (grad W_ij = grad_shape x_ij points from i towards j). Solids, ice and air are outside, so the water's face
@@ -157,7 +151,7 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
       const floatV k = two_rho0 * native_recip(rho_i + vloadV(0, R + j));
       /* eq. 1 along x_ij, per unit mass of i, and eq. 2 between water particles only */
 #ifdef THAW_TENSION_ADHESION
-      const floatV sa = -adhesion * b * akinci_adhesion_shape(q) * inv_r;
+      const floatV sa = -adhesion * b * THAW_AKINCI_ADHESION(q) * inv_r;
 #else
       const floatV sa = (floatV)(0.0f);
 #endif

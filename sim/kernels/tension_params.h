@@ -1,7 +1,8 @@
 /* The tension passes' parameters, shared verbatim by the host (sim/tension_stage.cpp) and tension.cl; every
- * member is 4 bytes, so both layouts agree (static_assert below). On the host also Akinci et al. 2013's two
- * kernel shapes, which sim/tension_stage.cpp integrates to calibrate the coefficients (tension.cl has them
- * on lanes; a test holds the two to each other through the calibration). */
+ * member is 4 bytes, so both layouts agree (static_assert below). Also Akinci et al. 2013's two kernel
+ * shapes: the adhesion's for every device pass that needs it, and both in double for the host, which
+ * integrates them to calibrate the coefficients (sim/tension_stage.cpp; tension.cl has the cohesion's on
+ * lanes). */
 #ifndef THAW_TENSION_PARAMS_H
 #define THAW_TENSION_PARAMS_H
 
@@ -27,6 +28,12 @@ typedef struct {
   unsigned int pad0, pad1;
 } TensionParams;
 
+/* Akinci et al. 2013 eq. 7 (their A(r)) on support H, with q = r / H: 0.007 / H^3 a(q), where
+ * a = (-4 q^2 + 6 q - 2)^(1/4) for 1/2 < q <= 1, else 0. The polynomial is -2 (2 q - 1)(q - 1), negative
+ * outside (1/2, 1), so the clamp at 0 is the whole range test. One expression for scalars and lanes
+ * (tension.cl's adhesion, rigid.cl's reaction to it) and, in double, for the host. */
+#define THAW_AKINCI_ADHESION(q) sqrt(sqrt(fmax(-4.0f * (q) * (q) + 6.0f * (q)-2.0f, 0.0f)))
+
 #ifndef __OPENCL_VERSION__
 /* Akinci et al. 2013 eq. 3 (their C(r)) on support H, with q = r / H: 32 / (pi H^3) c(q), where
  * c = (1 - q)^3 q^3 for 1/2 < q <= 1 and 2 (1 - q)^3 q^3 - 1/64 for 0 < q <= 1/2: attraction past H/2,
@@ -36,10 +43,9 @@ inline double akinci_cohesion_shape(double q) {
   return q > 1.0 ? 0.0 : (q > 0.5 ? a : 2.0 * a - 1.0 / 64.0);
 }
 
-/* Akinci et al. 2013 eq. 7 (their A(r)) on support H, with q = r / H: 0.007 / H^3 a(q), where
- * a = (-4 q^2 + 6 q - 2)^(1/4) for 1/2 < q <= 1, else 0. */
+/* THAW_AKINCI_ADHESION in double. */
 inline double akinci_adhesion_shape(double q) {
-  return (q > 0.5 && q <= 1.0) ? std::pow(std::max(-4.0 * q * q + 6.0 * q - 2.0, 0.0), 0.25) : 0.0;
+  return std::pow(std::max(-4.0 * q * q + 6.0 * q - 2.0, 0.0), 0.25);
 }
 
 static_assert(sizeof(TensionParams) == 32, "TensionParams must match its OpenCL layout");
