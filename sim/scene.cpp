@@ -71,6 +71,8 @@ const char* name(TensionModel m) {
       return "akinci2013";
     case TensionModel::Iwasaki2010:
       return "iwasaki2010";
+    case TensionModel::Brackbill1992:
+      return "brackbill1992";
     case TensionModel::None:
       break;
   }
@@ -301,8 +303,8 @@ HeatSettings heat_settings_from_json(const Json& doc) {
 
 TensionSettings tension_settings_from_json(const Json& t) {
   TensionSettings s;
-  s.model = choice_of<TensionModel>(
-      t["model"], {TensionModel::None, TensionModel::Akinci2013, TensionModel::Iwasaki2010});
+  s.model = choice_of<TensionModel>(t["model"], {TensionModel::None, TensionModel::Akinci2013,
+                                                 TensionModel::Iwasaki2010, TensionModel::Brackbill1992});
   s.coefficient = t["coefficient"].get<double>();
   s.curvature = t["curvature"].get<bool>();
   s.solid_contact_angle = t["solid_contact_angle"].get<double>();

@@ -41,7 +41,7 @@ enum class Multiphase { HuAdams2006, DomaradzkiMartyn };
 enum class ExposedArea { Iwasaki2010, Orthmann2013, Brackbill1992 };
 // Interfacial tension (sim/tension_stage.h): none, Akinci et al. 2013's cohesion, curvature and adhesion, or
 // Iwasaki et al. 2010's eq. 4.
-enum class TensionModel { None, Akinci2013, Iwasaki2010 };
+enum class TensionModel { None, Akinci2013, Iwasaki2010, Brackbill1992 };
 // How walls hold the fluid's tangential velocity: only through boundary_viscosity, or no-slip.
 enum class NoSlip { None, Adami2012 };
 // What a dryer is: an analytic cone of warm air that heats exposed ice and water (scenes without air

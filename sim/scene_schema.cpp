@@ -328,8 +328,11 @@ const Field& scene_schema() {
               "tension",
               {
                   choice(
-                      "model", {"none", "akinci2013", "iwasaki2010"},
-                      "Interfacial tension of water (docs/TENSION.md): akinci2013 = Akinci et al. 2013's "
+                      "model", {"none", "akinci2013", "iwasaki2010", "brackbill1992"},
+                      "Interfacial tension of water (docs/TENSION.md): brackbill1992 = Brackbill, Kothe & "
+                      "Zemach 1992's continuum surface force sigma kappa n on each surface particle's "
+                      "area, kappa from a quadric fitted to the surface near it, with Akinci et al. 2013's "
+                      "adhesion to solids and ice; akinci2013 = Akinci et al. 2013's "
                       "cohesion and curvature between water particles and adhesion to solids and ice; "
                       "iwasaki2010 = Iwasaki et al. 2010 eq. 4, an attraction k (x_j - x_i) / r^2 to water "
                       "and ice neighbours (and here solids). Both are calibrated from `coefficient` and "

@@ -275,9 +275,10 @@ std::unique_ptr<RigidIce> make_rigid_ice(ClRuntime& cl, ParticleStore& store, co
   // With tension the ice takes the reaction of the water's adhesion to it (rigid.cl, tension.cl).
   std::string options = opts;
   if (scene.tension.enabled())
-    options += scene.tension.model == TensionModel::Akinci2013
-                   ? " -DTHAW_TENSION_REACTION -DTHAW_TENSION_AKINCI2013"
-                   : " -DTHAW_TENSION_REACTION -DTHAW_TENSION_IWASAKI2010";
+    // brackbill1992 holds water to ice by akinci2013's adhesion
+    options += scene.tension.model == TensionModel::Iwasaki2010
+                   ? " -DTHAW_TENSION_REACTION -DTHAW_TENSION_IWASAKI2010"
+                   : " -DTHAW_TENSION_REACTION -DTHAW_TENSION_AKINCI2013";
   auto rigid =
       std::make_unique<RigidIce>(cl, store, options, capacity, rigid_settings(scene, k),
                                  std::move(anchored_by_id), rigid_mass_scales(scene, k.rest_density));

@@ -12,6 +12,13 @@ namespace thaw {
 namespace {
 
 constexpr std::size_t kColumns = 7;  // tension.cl's column block: W, R, V, B, NX, NY, NZ
+// brackbill1992's block adds DX, DY, DZ, A, K, K2, OK, BAND.
+constexpr std::size_t kCsfColumns = 15;
+// brackbill1992: the radius of the patch of surface points a particle's quadric is fitted to, and of the
+// average of the fitted curvatures, in spacings. Measured with numpy on lattice spheres of R = 6-16
+// spacings jittered by 0.1 spacing (docs/TENSION.md): the area-weighted mean of kappa R came within 6 % of 2;
+// at the support (2 spacings) the fits were too few to hold.
+constexpr double kFitRadius = 3.5, kSmoothRadius = 3.0;
 
 // int_0^1 q^p f(q) dq by Simpson's rule on 2000 intervals per half (the shapes have a kink at q = 1/2).
 double moment(double (*f)(double), int p) {
@@ -31,6 +38,20 @@ double moment(double (*f)(double), int p) {
 }
 
 double deg(double angle) { return angle * std::numbers::pi / 180.0; }
+
+// brackbill1992: sum over a square lattice of spacing dx of the 2-D cubic spline on support H (q = r / H:
+// 6 q^3 - 6 q^2 + 1 to 1/2, 2 (1 - q)^3 to 1; unnormalised, as tension.cl sums it), the outer layer's points
+// per spacing squared on a flat face of the lattice.
+double layer_density(double dx, double H) {
+  const int m = static_cast<int>(std::ceil(H / dx));
+  double sum = 0;
+  for (int a = -m; a <= m; ++a)
+    for (int b = -m; b <= m; ++b) {
+      const double q = dx * std::sqrt(double(a * a + b * b)) / H;
+      sum += q < 0.5 ? 6 * q * q * (q - 1) + 1 : (q < 1 ? 2 * (1 - q) * (1 - q) * (1 - q) : 0.0);
+    }
+  return sum;
+}
 
 }  // namespace
 
@@ -73,12 +94,22 @@ TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields
     : cl_(cl), store_(store), core_(core), layout_(layout), model_(scene.tension.model) {
   std::string opts = build_options + " -DTHAW_TENSION_";
   for (const char* c = name(model_); *c; ++c) opts += static_cast<char>(std::toupper(*c));
+  const bool csf = model_ == TensionModel::Brackbill1992;
+  const double dx = scene.spacing;
+  // Cells are the support wide (grid_common.h): the fit's patch reaches this many of them.
+  if (csf)
+    opts += " -DTHAW_FIT_REACH=" + std::to_string(static_cast<int>(std::ceil(kFitRadius * dx / k.support)));
   // Adhesion only where water can meet solids or ice.
   if (!scene.walls.empty() || !scene.solids.empty() || !scene.ice.empty()) opts += " -DTHAW_TENSION_ADHESION";
   const auto program =
       cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "tension_params.h", "tension.cl"}, opts);
   k_columns_ = cl::Kernel(program, "tension_columns");
   if (model_ == TensionModel::Akinci2013) k_normals_ = cl::Kernel(program, "tension_normals");
+  if (csf) {
+    k_surface_ = cl::Kernel(program, "tension_surface");
+    k_curvature_ = cl::Kernel(program, "tension_curvature");
+    k_smooth_ = cl::Kernel(program, "tension_smooth");
+  }
   k_forces_ = cl::Kernel(program, "tension_forces");
 
   const TensionCoefficients c = tension_coefficients(scene, k);
@@ -87,11 +118,19 @@ TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields
   params_.cohesion = static_cast<float>(c.cohesion);
   params_.curvature = scene.tension.curvature ? 1.0f : 0.0f;
   params_.stride = layout.stride;
+  if (csf) {
+    params_.sigma = static_cast<float>(scene.tension.coefficient);
+    params_.volume = static_cast<float>(dx * dx * dx);
+    params_.spacing = static_cast<float>(dx);
+    params_.layer_area = static_cast<float>(dx * dx * layer_density(dx, k.support));
+    params_.fit_radius = static_cast<float>(kFitRadius * dx);
+    params_.smooth_radius = static_cast<float>(kSmoothRadius * dx);
+  }
   std::vector<float> adhesion = c.adhesion;
   if (adhesion.empty()) adhesion.push_back(0.0f);
   adhesion_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                          adhesion.size() * sizeof(float), adhesion.data());
-  const std::size_t bytes = std::size_t(layout.stride) * kColumns * sizeof(float);
+  const std::size_t bytes = std::size_t(layout.stride) * (csf ? kCsfColumns : kColumns) * sizeof(float);
   columns_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, bytes);
   cl.queue().enqueueFillBuffer(columns_, 0.0f, 0, bytes);
 }
@@ -109,6 +148,20 @@ void TensionStage::run(const NeighbourView& nv, const cl::Buffer& accel) {
     set_args(k_normals_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
              columns_);
     launch(q, k_normals_, layout_.n);
+  }
+  if (model_ == TensionModel::Brackbill1992) {
+    set_args(k_surface_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
+             columns_);
+    launch(q, k_surface_, layout_.n);
+    set_args(k_curvature_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
+             columns_);
+    launch(q, k_curvature_, layout_.n);
+    // twice: K into K2, K2 back into K (tension.cl's columns 11 and 12)
+    for (const cl_int from : {11, 12}) {
+      set_args(k_smooth_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
+               columns_, from, cl_int(23 - from));
+      launch(q, k_smooth_, layout_.n);
+    }
   }
   set_args(k_forces_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
            columns_, accel);

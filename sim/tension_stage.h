@@ -1,18 +1,22 @@
 #pragma once
 // The tension stage: interfacial tension of water (tension.model), accelerations added to the forces pass's
-// before the time step is chosen, so both WCSPH and DFSPH (its predicted velocities) take them. Two models,
+// before the time step is chosen, so both WCSPH and DFSPH (its predicted velocities) take them. Three models,
 // selectable by name (sim/kernels/tension.cl has the equations):
 //   akinci2013: Akinci, Akinci & Teschner 2013, cohesion (eqs. 1, 3) and curvature (eqs. 2, 4) between
 //     water particles, K_ij-corrected (eq. 5);
 //   iwasaki2010: Iwasaki et al. 2010 eq. 4, an attraction k (x_j - x_i) / r^2 to water and ice neighbours
-//     (solids here too).
-// Both are calibrated from the scene's sigma [N/m]: a pair force f(r) between particles of
-// number density n gives a flat surface the tension sigma = (pi n^2 / 8) int r^4 f dr (Kirkwood & Buff 1949,
-// the particles taken as uniform). Water clings to solids and ice by Akinci et al. 2013's adhesion (eqs. 6,
-// 7), Iwasaki's model by its own k_ice term,, set from the contact angles: a pair force f_fs gives a
-// water-solid face the work of adhesion W = (pi n_f n_s / 4) int r^4 f_fs dr, set to sigma (1 + cos theta)
-// (Young-Dupre), the water's face against the solid having tension sigma in every model. Built only for
-// scenes with flow and tension.model other than none.
+//     (solids here too);
+//   brackbill1992: Brackbill, Kothe & Zemach 1992's continuum surface force sigma kappa n on the outer
+//   layer's
+//     particles, each with its share of the area (the layer's 2-D density) and kappa from a quadric fitted to
+//     the surface points near it; sigma enters as it is, no calibration.
+// The two pair-force models are calibrated from the scene's sigma [N/m]: a pair force f(r) between particles
+// of number density n gives a flat surface the tension sigma = (pi n^2 / 8) int r^4 f dr (Kirkwood & Buff
+// 1949, the particles taken as uniform). Water clings to solids and ice by Akinci et al. 2013's adhesion
+// (eqs. 6, 7) (brackbill1992 too), Iwasaki's model by its own k_ice term, set from the contact angles: a pair
+// force f_fs gives a water-solid face the work of adhesion W = (pi n_f n_s / 4) int r^4 f_fs dr, set to sigma
+// (1 + cos theta) (Young-Dupre), the water's face against the solid having tension sigma in every model.
+// Built only for scenes with flow and tension.model other than none.
 #include <CL/opencl.hpp>
 #include <string>
 #include <vector>
@@ -56,6 +60,7 @@ class TensionStage {
   TensionModel model_;
   tension::TensionParams params_{};
   cl::Kernel k_columns_, k_normals_, k_forces_;
+  cl::Kernel k_surface_, k_curvature_, k_smooth_;  // brackbill1992
   cl::Buffer adhesion_, columns_;
 };
 

@@ -1,6 +1,6 @@
 /* Interfacial tension of water (sim/tension_stage.h): accelerations added to the forces pass's. Built with
- * sph_kernel.h, grid_common.h, sph_lanes.h and tension_params.h, with -DTHAW_TENSION_<model>: AKINCI2013 or
- * IWASAKI2010.
+ * sph_kernel.h, grid_common.h, sph_lanes.h and tension_params.h, with -DTHAW_TENSION_<model>: AKINCI2013,
+ * IWASAKI2010 or BRACKBILL1992 (with -DTHAW_FIT_REACH, the cells the fit's patch reaches).
  * Water particles attract water particles; solids and ice (the boundary particles) hold water by
  * adhesion; air takes no part. The neighbour passes read a block of seven columns of stride floats, so
  * the candidates come THAW_VW at a time (grid_common.h):
@@ -9,13 +9,27 @@
  *   V: the volume m_j / rho_j of water particles, 0 for the rest;
  *   B: the adhesion weight (akinci2013: beta Psi_b; iwasaki2010: k of eq. 4) of boundary particles, 0 for
  *      the rest, beta or k per boundary material from `adhesion` (set from the contact angles);
- *   NX, NY, NZ: akinci2013's normals n_j (tension_normals), 0 where there are none. */
+ *   NX, NY, NZ: akinci2013's normals n_j (tension_normals), brackbill1992's unit normals (outward), 0 where
+ *      there are none;
+ * and for brackbill1992 (tension_surface, tension_curvature, tension_smooth), where V is instead the colour's
+ * rest volume dx^3 of every inside particle (water, ice, solids; air: 0):
+ *   DX, DY, DZ: from the particle to its surface point, n_i dx / 2 on the outer layer;
+ *   A: an outer-layer particle's share of the surface area (0 elsewhere);
+ *   K, K2: the curvature, fitted and averaged (two columns to average from one into the other);
+ *   OK: 1 where the fit held;
+ *   BAND: 1 on the outer layer (tension_surface), whose surface points are fitted. */
 
 #define COL_W 0
 #define COL_R 1
 #define COL_V 2
 #define COL_B 3
 #define COL_NX 4
+#define COL_DX 7
+#define COL_A 10
+#define COL_K 11
+#define COL_K2 12
+#define COL_OK 13
+#define COL_BAND 14
 
 kernel void tension_columns(global const uchar* phase, global const uchar* material, global const float4* pos,
                             global const float* density, global const float* adhesion, const TensionParams P,
@@ -27,7 +41,7 @@ kernel void tension_columns(global const uchar* phase, global const uchar* mater
   if (i < P.n) {
     const uchar ph = phase[i];
     const float m = pos[i].w;
-#ifdef THAW_TENSION_AKINCI2013
+#if defined(THAW_TENSION_AKINCI2013) || defined(THAW_TENSION_BRACKBILL1992)
     const float weight = m;
 #else
     const float weight = 1.0f;
@@ -39,6 +53,9 @@ kernel void tension_columns(global const uchar* phase, global const uchar* mater
     } else if (THAW_IS_STATIC(ph)) {
       b = adhesion[material[i]] * weight;
     }
+#ifdef THAW_TENSION_BRACKBILL1992
+    v = ph == THAW_PHASE_AIR ? 0.0f : P.volume;
+#endif
   }
   col[COL_W * stride + i] = w;
   col[COL_R * stride + i] = r;
@@ -47,6 +64,9 @@ kernel void tension_columns(global const uchar* phase, global const uchar* mater
   col[(COL_NX + 0) * stride + i] = 0.0f;
   col[(COL_NX + 1) * stride + i] = 0.0f;
   col[(COL_NX + 2) * stride + i] = 0.0f;
+#ifdef THAW_TENSION_BRACKBILL1992
+  for (int k = COL_DX; k <= COL_BAND; ++k) col[k * stride + i] = 0.0f;
+#endif
 }
 
 /* A neighbour pass's start: particle i's position and cell, the support and the candidates' x, y, z. */
@@ -98,6 +118,225 @@ kernel void tension_normals(global const float4* pos, global const uchar* phase,
 }
 #endif
 
+#ifdef THAW_TENSION_BRACKBILL1992
+/* Brackbill, Kothe & Zemach 1992's continuum surface force, f = sigma kappa n delta, on each surface
+ * particle's share of the surface: a_i = v |grad c_i| scaled as the surface stage's brackbill1992 areas
+ * (docs/SURFACE.md), so the force on a patch of surface is sigma kappa times its area and a still drop holds
+ * Laplace's jump 2 sigma / R. The colour c counts water, ice and solids as inside, so a face against a wall
+ * or ice carries no tension; the water holds to them by Akinci et al. 2013's adhesion. Taking the divergence
+ * of the normals for kappa, as Brackbill et al. do, is too noisy on particles (docs/TENSION.md): kappa here is
+ * the mean curvature of a quadric fitted by least squares to the surface points near the particle (as the
+ * height functions of volume-of-fluid codes do on cells), the outer layer's particles moved out half a spacing
+ * along their normals. */
+
+/* Each water particle's colour gradient over the inside, grad c_i = sum_j v_j grad W_ij, and its outward
+ * normal n_i = -grad c / |grad c|. A particle is on the outer layer where no
+ * inside neighbour lies within 45 degrees of n_i above it (the cone of Marrone et al. 2010's free-surface
+ * test); its surface point lies half a spacing out along n_i. The layer, not a threshold on the colour, marks
+ * it: the equation of state holds the outer layer only once it is packed to the rest density, where its
+ * colour is that of the bulk. */
+kernel void tension_surface(global const float4* pos, global const uchar* phase, global const float* soa,
+                            global const uint* cell_start, const Grid g, const TensionParams P,
+                            global float* col) {
+  const uint i = get_global_id(0);
+  if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
+  const uint stride = P.stride;
+  TENSION_START
+  global const float* V = col + COL_V * stride;
+  floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f);
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
+    for (uint j = jb; j < je; j += THAW_VW) {
+      const floatV dx = pr.x - vloadV(0, X + j), dy = pr.y - vloadV(0, Y + j), dz = pr.z - vloadV(0, Z + j);
+      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV s = select((floatV)(0.0f), vloadV(0, V + j), in) * grad_shape(sqrt(r2) * inv_H);
+      gx += s * dx;
+      gy += s * dy;
+      gz += s * dz;
+    }
+  }
+  const float3 grad = THAW_SIGMA(H) * inv_H * inv_H * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
+  const float g_len = length(grad);
+  if (!(g_len > 0.0f)) return;
+  const float3 n = -grad / g_len;
+  col[(COL_NX + 0) * stride + i] = n.x;
+  col[(COL_NX + 1) * stride + i] = n.y;
+  col[(COL_NX + 2) * stride + i] = n.z;
+  /* the cone: (x_j - x_i) . n > |x_j - x_i| cos 45 degrees, over inside neighbours within the support */
+  int covered = 0;
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
+    for (uint j = jb; j < je && !covered; ++j) {
+      if (!(V[j] > 0.0f)) continue;
+      const float3 o = (float3)(X[j] - pr.x, Y[j] - pr.y, Z[j] - pr.z);
+      const float r2 = dot(o, o);
+      const float up = dot(o, n);
+      covered = r2 < H2 && up > 0.0f && up * up > 0.5f * r2;
+    }
+  }
+  if (covered) return;
+  const float d = 0.5f * P.spacing;
+  col[(COL_DX + 0) * stride + i] = n.x * d;
+  col[(COL_DX + 1) * stride + i] = n.y * d;
+  col[(COL_DX + 2) * stride + i] = n.z * d;
+  col[COL_BAND * stride + i] = 1.0f;
+}
+
+/* Visits the rows of cells within THAW_FIT_REACH of cell c (the fit's and the average's patches reach past
+ * the support), as FOR_EACH_NEIGHBOUR_ROW does within THAW_REACH. */
+#define FOR_EACH_FIT_ROW(g, cell_start, c, jb, je)                                                 \
+  for (int dz_ = -THAW_FIT_REACH; dz_ <= THAW_FIT_REACH; ++dz_)                                    \
+    for (int dy_ = -THAW_FIT_REACH; dy_ <= THAW_FIT_REACH; ++dy_)                                  \
+      for (int row_ = neighbour_row(g, c, dz_, dy_); row_ >= 0; row_ = -1)                         \
+        for (uint jb = (cell_start)[row_ + max((c).x - THAW_FIT_REACH, 0)],                        \
+                  je = (cell_start)[row_ + min((c).x + THAW_FIT_REACH, (g).nx - 1) + 1], once_ = 1; \
+             once_; once_ = 0)
+
+/* Surface particle j's surface point less particle i's, s_j - s_i = (x_j - x_i) + D_j - D_i, with pr as
+ * particle i's position that row sees (minimum image). */
+float3 surface_offset(const float4 pr, const uint j, global const float* X, global const float* Y,
+                      global const float* Z, global const float* col, const uint stride, const float3 di) {
+  const float3 dj = (float3)(col[(COL_DX + 0) * stride + j], col[(COL_DX + 1) * stride + j],
+                             col[(COL_DX + 2) * stride + j]);
+  return (float3)(X[j] - pr.x, Y[j] - pr.y, Z[j] - pr.z) + dj - di;
+}
+
+/* kappa_i: the mean curvature at s_i of the quadric h = a u^2 + b u v + c v^2 + d u + e v + f fitted by
+ * weighted least squares to the surface points s_j of the surface particles within fit_radius of s_i whose
+ * normals lie within 60 degrees of n_i, in the frame (e1, e2, n_i), lengths in spacings; weights
+ * 1 - (u^2 + v^2) / r_fit^2 (tangential distance), and 1e-3 beyond. kappa = -2 (a + c) / dx, positive where
+ * the surface bulges out (a drop). Fewer than 8 points, or a singular fit: no curvature (OK = 0). */
+kernel void tension_curvature(global const float4* pos, global const uchar* phase, global const float* soa,
+                              global const uint* cell_start, const Grid g, const TensionParams P,
+                              global float* col) {
+  const uint i = get_global_id(0);
+  if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
+  const uint stride = P.stride;
+  global const float* BAND = col + COL_BAND * stride;
+  if (!(BAND[i] > 0.0f)) return;
+  TENSION_START
+  const float3 ni = (float3)(col[(COL_NX + 0) * stride + i], col[(COL_NX + 1) * stride + i],
+                             col[(COL_NX + 2) * stride + i]);
+  const float3 di = (float3)(col[(COL_DX + 0) * stride + i], col[(COL_DX + 1) * stride + i],
+                             col[(COL_DX + 2) * stride + i]);
+  /* a tangent frame: e1 across the axis n_i leans least towards */
+  const float3 ax = fabs(ni.x) < 0.6f ? (float3)(1.0f, 0.0f, 0.0f) : (float3)(0.0f, 1.0f, 0.0f);
+  const float3 e1 = normalize(cross(ni, ax)), e2 = cross(ni, e1);
+  const float inv_dx = 1.0f / P.spacing, rf2 = P.fit_radius * P.fit_radius;
+  const float rf2_dx = rf2 * inv_dx * inv_dx;
+  float m[21], rhs[6];
+  for (int k = 0; k < 21; ++k) m[k] = 0.0f;
+  for (int k = 0; k < 6; ++k) rhs[k] = 0.0f;
+  int count = 0;
+  float density = 0.0f; /* the layer's points per area around s_i: sum_j W_2D(tangential distance) */
+  const float h2d = H * inv_dx; /* the 2-D kernel's support, in spacings */
+  global const float* NX = col + (COL_NX + 0) * stride;
+  global const float* NY = col + (COL_NX + 1) * stride;
+  global const float* NZ = col + (COL_NX + 2) * stride;
+  FOR_EACH_FIT_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
+    for (uint j = jb; j < je; ++j) {
+      if (!(BAND[j] > 0.0f)) continue;
+      if (NX[j] * ni.x + NY[j] * ni.y + NZ[j] * ni.z <= 0.5f) continue;
+      const float3 o = surface_offset(pr, j, X, Y, Z, col, stride, di);
+      if (dot(o, o) >= rf2) continue;
+      const float u = dot(o, e1) * inv_dx, v = dot(o, e2) * inv_dx, h = dot(o, ni) * inv_dx;
+      const float w = fmax(1.0f - (u * u + v * v) / rf2_dx, 0.0f) + 1e-3f;
+      const float q = sqrt(u * u + v * v) / h2d;
+      density += q < 0.5f ? 6.0f * q * q * (q - 1.0f) + 1.0f : (q < 1.0f ? 2.0f * (1.0f - q) * (1.0f - q) * (1.0f - q) : 0.0f);
+      const float b[6] = {u * u, u * v, v * v, u, v, 1.0f};
+      int k = 0;
+      for (int r = 0; r < 6; ++r) {
+        for (int s = r; s < 6; ++s) m[k++] += w * b[r] * b[s];
+        rhs[r] += w * b[r] * h;
+      }
+      ++count;
+    }
+  }
+  if (count < 8) return;
+  /* The normal equations (symmetric positive semi-definite) by Gaussian elimination with partial pivoting. */
+  float a[6][7];
+  {
+    int k = 0;
+    for (int r = 0; r < 6; ++r)
+      for (int s = r; s < 6; ++s) {
+        a[r][s] = m[k];
+        a[s][r] = m[k];
+        ++k;
+      }
+    for (int r = 0; r < 6; ++r) a[r][6] = rhs[r];
+  }
+  const float scale = a[5][5]; /* the sum of the weights */
+  for (int p = 0; p < 6; ++p) {
+    int best = p;
+    for (int r = p + 1; r < 6; ++r)
+      if (fabs(a[r][p]) > fabs(a[best][p])) best = r;
+    if (!(fabs(a[best][p]) > 1e-6f * scale)) return;
+    if (best != p)
+      for (int s = p; s < 7; ++s) {
+        const float t = a[p][s];
+        a[p][s] = a[best][s];
+        a[best][s] = t;
+      }
+    for (int r = p + 1; r < 6; ++r) {
+      const float f = a[r][p] / a[p][p];
+      for (int s = p; s < 7; ++s) a[r][s] -= f * a[p][s];
+    }
+  }
+  float x[6];
+  for (int r = 5; r >= 0; --r) {
+    float t = a[r][6];
+    for (int s = r + 1; s < 6; ++s) t -= a[r][s] * x[s];
+    x[r] = t / a[r][r];
+  }
+  /* A surface curved tighter than a sphere of two spacings' radius is not resolved by the particles: such
+   * fits come from stray particles and broken patches, whose kicks would spray the water. */
+  col[COL_K * stride + i] = -2.0f * (x[0] + x[2]) * inv_dx;
+  col[COL_OK * stride + i] = 1.0f;
+  /* its share of the surface: the inverse of the layer's 2-D SPH density (the cubic spline in 2-D on support
+   * H, normalised by its sum over a square lattice of spacing dx: P.layer_area, so a flat face of the lattice
+   * gives dx^2 a particle) */
+  col[COL_A * stride + i] = P.layer_area / density;
+}
+
+/* The fitted curvatures averaged over the layer's particles within smooth_radius whose fits held and whose
+ * normals lie within 60 degrees of n_i, weighted by their areas and 1 - r^2 / r_s^2: from column `from` into
+ * column `to`. */
+kernel void tension_smooth(global const float4* pos, global const uchar* phase, global const float* soa,
+                           global const uint* cell_start, const Grid g, const TensionParams P,
+                           global float* col, const int from, const int to) {
+  const uint i = get_global_id(0);
+  if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
+  const uint stride = P.stride;
+  global const float* OK = col + COL_OK * stride;
+  global const float* A = col + COL_A * stride;
+  if (!(OK[i] > 0.0f)) return;
+  TENSION_START
+  global const float* K = col + from * stride;
+  global const float* NX = col + (COL_NX + 0) * stride;
+  global const float* NY = col + (COL_NX + 1) * stride;
+  global const float* NZ = col + (COL_NX + 2) * stride;
+  const float3 ni = (float3)(NX[i], NY[i], NZ[i]);
+  const float rs2 = P.smooth_radius * P.smooth_radius;
+  float sw = 0.0f, sk = 0.0f;
+  FOR_EACH_FIT_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
+    for (uint j = jb; j < je; ++j) {
+      if (!(OK[j] > 0.0f)) continue;
+      if (NX[j] * ni.x + NY[j] * ni.y + NZ[j] * ni.z <= 0.5f) continue;
+      const float3 o = (float3)(X[j] - pr.x, Y[j] - pr.y, Z[j] - pr.z);
+      const float r2 = dot(o, o);
+      if (r2 >= rs2) continue;
+      const float w = A[j] * (1.0f - r2 / rs2);
+      sw += w;
+      sk += w * K[j];
+    }
+  }
+  col[to * stride + i] = sk / sw; /* i itself is among them */
+}
+#endif
+
 /* Each water particle's tension acceleration, added to the forces pass's:
  *   akinci2013 (eqs. 1, 2, 5, per unit mass of i): a_i = -gamma sum_j K_ij (m_j C(r) x_ij / r
  *     + (n_i - n_j)), K_ij = 2 rho0 / (rho_i + rho_j), over water neighbours;
@@ -105,6 +344,7 @@ kernel void tension_normals(global const float4* pos, global const uchar* phase,
  *     neighbours and the boundary material's k for solids and ice;
  * and for akinci2013 the adhesion of its eq. 6, -sum_b beta Psi_b A(r) x_ib / r over
  * boundary neighbours b (solids and ice), built with -DTHAW_TENSION_ADHESION where the scene has any. */
+#ifndef THAW_TENSION_BRACKBILL1992
 kernel void tension_forces(global const float4* pos, global const uchar* phase, global const float* soa,
                            global const uint* cell_start, const Grid g, const TensionParams P,
                            global const float* col, global float4* accel) {
@@ -166,3 +406,46 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
   }
   accel[i] += (float4)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az), 0.0f);
 }
+#else
+/* brackbill1992 (per unit mass of i): a_i = -sigma kappa_i a_i n_i / m_i, and where the scene
+ * has solids or ice Akinci et al. 2013's adhesion, as akinci2013 has it. */
+kernel void tension_forces(global const float4* pos, global const uchar* phase, global const float* soa,
+                           global const uint* cell_start, const Grid g, const TensionParams P,
+                           global const float* col, global float4* accel) {
+  const uint i = get_global_id(0);
+  if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
+  const uint stride = P.stride;
+  const float4 pi = pos[i];
+  const float3 n = (float3)(col[(COL_NX + 0) * stride + i], col[(COL_NX + 1) * stride + i],
+                            col[(COL_NX + 2) * stride + i]);
+  /* 0 off the outer layer and where the fit failed (A and K are 0 there) */
+  float3 a = -P.sigma * col[COL_K * stride + i] * col[COL_A * stride + i] / pi.w * n;
+#ifdef THAW_TENSION_ADHESION
+  {
+    const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+    const int4 c = grid_cell(g, pi);
+    global const float* X = soa;
+    global const float* Y = soa + stride;
+    global const float* Z = soa + 2 * stride;
+    global const float* B = col + COL_B * stride;
+    const float adhesion = 0.007f / (H * H * H);
+    floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
+    FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+      const float4 pr = THAW_ROW_POS(g, c, pi);
+      for (uint j = jb; j < je; j += THAW_VW) {
+        const floatV dx = pr.x - vloadV(0, X + j), dy = pr.y - vloadV(0, Y + j), dz = pr.z - vloadV(0, Z + j);
+        const floatV r2 = dx * dx + dy * dy + dz * dz;
+        const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2) & (r2 > 1e-12f * H2);
+        const floatV inv_r = native_rsqrt(fmax(r2, 1e-30f)), q = r2 * inv_r * inv_H;
+        const floatV s = -adhesion * vloadV(0, B + j) * THAW_AKINCI_ADHESION(q) * inv_r;
+        ax += select((floatV)(0.0f), s * dx, in);
+        ay += select((floatV)(0.0f), s * dy, in);
+        az += select((floatV)(0.0f), s * dz, in);
+      }
+    }
+    a += (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));
+  }
+#endif
+  accel[i] += (float4)(a, 0.0f);
+}
+#endif

@@ -25,7 +25,14 @@ typedef struct {
   float curvature; /* 1: akinci2013's curvature term (eq. 2); 0: not */
   unsigned int n;
   unsigned int stride;
-  unsigned int pad0, pad1;
+  /* brackbill1992 only: */
+  float sigma;         /* the tension [N/m] */
+  float volume;        /* dx^3: every inside particle's (water, ice, solid) volume in the colour */
+  float spacing;       /* dx [m] */
+  float layer_area;    /* dx^2 times the 2-D cubic spline's sum over a square lattice of spacing dx */
+  float fit_radius;    /* radius [m] of the patch of surface points the quadric is fitted to */
+  float smooth_radius; /* radius [m] over which the fitted curvatures are averaged */
+  unsigned int pad0, pad1, pad2, pad3;
 } TensionParams;
 
 /* Akinci et al. 2013 eq. 7 (their A(r)) on support H, with q = r / H: 0.007 / H^3 a(q), where
@@ -48,7 +55,7 @@ inline double akinci_adhesion_shape(double q) {
   return std::pow(std::max(-4.0 * q * q + 6.0 * q - 2.0, 0.0), 0.25);
 }
 
-static_assert(sizeof(TensionParams) == 32, "TensionParams must match its OpenCL layout");
+static_assert(sizeof(TensionParams) == 64, "TensionParams must match its OpenCL layout");
 }  // namespace thaw::tension
 #endif
 

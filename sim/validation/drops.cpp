@@ -25,7 +25,7 @@ Field drop_params(std::vector<Field> own) {
       number("radius", "R of the drop").in("m").def(0.005).above(0),
       number("density", "rho of water").in("kg/m^3").def(1000.0).above(0),
       number("viscosity", "mu of water").in("Pa s").def(0.0018).at_least(0),
-      choice("model", {"akinci2013", "iwasaki2010"}, "tension.model").def("akinci2013"),
+      choice("model", {"akinci2013", "iwasaki2010", "brackbill1992"}, "tension.model").def("akinci2013"),
       number("sigma", "tension.coefficient").in("N/m").def(0.0756).above(0),
       flag("curvature", "tension.curvature (akinci2013)").def(true),
   };

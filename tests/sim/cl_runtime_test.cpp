@@ -75,8 +75,9 @@ TEST_F(KernelBuild, EveryEmbeddedStageBuilds) {
         {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h", "surface_params.h", "surface.cl"},
         std::string("-DTHAW_REACH=1 -DTHAW_VW=8 ") + model))
         << model;
-  // The tension stage, both models (sim/tension_stage.cpp).
-  for (const char* model : {"-DTHAW_TENSION_AKINCI2013", "-DTHAW_TENSION_IWASAKI2010"})
+  // The tension stage, its three models (sim/tension_stage.cpp).
+  for (const char* model : {"-DTHAW_TENSION_AKINCI2013", "-DTHAW_TENSION_IWASAKI2010",
+                            "-DTHAW_TENSION_BRACKBILL1992 -DTHAW_FIT_REACH=2 -DTHAW_TENSION_ADHESION"})
     EXPECT_NO_THROW(
         cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "tension_params.h", "tension.cl"},
                    std::string("-DTHAW_REACH=1 -DTHAW_VW=8 ") + model))
@@ -128,6 +129,7 @@ TEST_F(KernelBuild, EveryProgramIsPortableOpenClC) {
   // Tension, both models, beside free ice (rigid.cl takes the adhesion's reaction).
   variants.push_back({"default", {"tension.model=akinci2013"}});
   variants.push_back({"default", {"tension.model=iwasaki2010", "solver.pressure=dfsph"}});
+  variants.push_back({"default", {"tension.model=brackbill1992"}});
   // Air beside the meltwater: the multiphase passes (both models), eq 8's buoyancy, and room air through an
   // open top.
   const std::string air_material =

@@ -106,6 +106,8 @@ TEST_F(TensionTest, TheStageIsBuiltOnlyWhenTheSceneHasTension) {
   EXPECT_NE(stages(block_scene({{"model", "akinci2013"}})).find("tension (akinci2013)"), std::string::npos);
   EXPECT_NE(stages(block_scene({{"model", "iwasaki2010"}}, "dfsph")).find("tension (iwasaki2010)"),
             std::string::npos);
+  EXPECT_NE(stages(block_scene({{"model", "brackbill1992"}})).find("tension (brackbill1992)"),
+            std::string::npos);
   // Without flow nothing moves: no tension pass.
   Json still = block_scene({{"model", "akinci2013"}});
   still["solver"]["flow"] = false;
@@ -139,7 +141,7 @@ TEST_F(TensionTest, ThePairForcesMoveNoMomentum) {
 // tension it keeps its shape.
 TEST_F(TensionTest, TensionPullsALongBlockRound) {
   for (const char* pressure : {"wcsph", "dfsph"})
-    for (const char* model : {"none", "akinci2013"}) {
+    for (const char* model : {"none", "akinci2013", "brackbill1992"}) {
       const Scene scene = scene_from_json(block_scene({{"model", model}}, pressure));
       SimState st = initial_state(scene);
       const double start = elongation(st.particles);
@@ -152,6 +154,34 @@ TEST_F(TensionTest, TensionPullsALongBlockRound) {
       else
         EXPECT_LT(end / start, 0.5) << pressure;
     }
+}
+
+// brackbill1992 on a still drop of R = 8 spacings cut from the lattice: the first step's velocities are the
+// tension's alone (the pressure is clamped at zero, and nothing moves yet), and their pull towards the centre
+// adds up to Laplace's jump times the area, 2 sigma / R * 4 pi R^2, R from the drop's volume N dx^3.
+TEST_F(TensionTest, TheSurfaceForceOnAStillDropAddsUpToLaplaces) {
+  Json doc = block_scene({{"model", "brackbill1992"}});
+  doc["fluids"] = Json::parse(R"([{"material": "water", "shape": "sphere", "centre": [0, 0, 0],
+                                   "radius": 0.008}])");
+  doc["domain"] = Json::parse(R"({"min": [-0.012, -0.012, -0.012], "max": [0.012, 0.012, 0.012]})");
+  doc["solver"]["max_dt"] = 1e-6;
+  const Scene scene = scene_from_json(doc);
+  Solver s(cl(), scene, initial_state(scene));
+  s.step();
+  const double dt = s.time();
+  const HostParticles p = s.particles();
+  double inward = 0, net[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto& x = p.position[i];  // moved by 1e-6 s of the pull only
+    const double r = std::hypot(x[0], x[1], x[2]), m = x[3];
+    for (int a = 0; a < 3; ++a) net[a] += m * p.velocity[i][a] / dt;
+    if (r > 0)
+      inward -= m * (p.velocity[i][0] * x[0] + p.velocity[i][1] * x[1] + p.velocity[i][2] * x[2]) / (r * dt);
+  }
+  const double R = std::cbrt(3.0 * double(p.size()) / (4.0 * std::numbers::pi)) * 0.001;
+  const double laplace = 2.0 * 0.0756 / R * 4.0 * std::numbers::pi * R * R;
+  EXPECT_NEAR(inward / laplace, 1.0, 0.1);
+  EXPECT_LT(std::hypot(net[0], net[1], net[2]) / laplace, 0.01);
 }
 
 }  // namespace
