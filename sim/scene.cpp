@@ -15,6 +15,7 @@
 #include "sim/error.h"
 #include "sim/geometry/mesh.h"
 #include "sim/json_text.h"
+#include "sim/kernels/tension_params.h"
 
 namespace thaw {
 
@@ -593,6 +594,17 @@ Scene convert_and_check(Json doc, const std::string& folder) {
       throw SceneError("solver.periodic", "the domain is " + format_number(length) + " m long along " + axis +
                                               ", less than 3 kernel supports (" +
                                               format_number(3.0 * support) + " m)");
+    // brackbill1992 fits the surface over the cells within tension::kFitRadius spacings: around an axis of
+    // fewer cells than that walk spans it would visit a row twice (grid_common.h's rows wrap).
+    if (s.tension.model == TensionModel::Brackbill1992) {
+      const int reach = static_cast<int>(std::ceil(tension::kFitRadius * s.spacing / support - 1e-9));
+      const double needed = (2.0 * reach + 1.0) * support;
+      if (length < needed * (1.0 - 1e-9))
+        throw SceneError("tension.model",
+                         "brackbill1992 fits the surface over " + std::to_string(2 * reach + 1) +
+                             " kernel supports: the periodic axis " + axis + " must be at least " +
+                             format_number(needed) + " m long; it is " + format_number(length) + " m");
+    }
   }
 
   if (s.solver.no_slip != NoSlip::None)

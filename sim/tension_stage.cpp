@@ -14,11 +14,6 @@ namespace {
 constexpr std::size_t kColumns = 7;  // tension.cl's column block: W, R, V, B, NX, NY, NZ
 // brackbill1992's block adds DX, DY, DZ, A, K, K2, OK, BAND.
 constexpr std::size_t kCsfColumns = 15;
-// brackbill1992: the radius of the patch of surface points a particle's quadric is fitted to, and of the
-// average of the fitted curvatures, in spacings. Measured with numpy on lattice spheres of R = 6-16
-// spacings jittered by 0.1 spacing (docs/TENSION.md): the area-weighted mean of kappa R came within 6 % of 2;
-// at the support (2 spacings) the fits were too few to hold.
-constexpr double kFitRadius = 3.5, kSmoothRadius = 3.0;
 
 // int_0^1 q^p f(q) dq by Simpson's rule on 2000 intervals per half (the shapes have a kink at q = 1/2).
 double moment(double (*f)(double), int p) {
@@ -98,7 +93,8 @@ TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields
   const double dx = scene.spacing;
   // Cells are the support wide (grid_common.h): the fit's patch reaches this many of them.
   if (csf)
-    opts += " -DTHAW_FIT_REACH=" + std::to_string(static_cast<int>(std::ceil(kFitRadius * dx / k.support)));
+    opts += " -DTHAW_FIT_REACH=" +
+            std::to_string(static_cast<int>(std::ceil(tension::kFitRadius * dx / k.support)));
   // Adhesion only where water can meet solids or ice.
   if (!scene.walls.empty() || !scene.solids.empty() || !scene.ice.empty()) opts += " -DTHAW_TENSION_ADHESION";
   const auto program =
@@ -123,8 +119,8 @@ TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields
     params_.volume = static_cast<float>(dx * dx * dx);
     params_.spacing = static_cast<float>(dx);
     params_.layer_area = static_cast<float>(dx * dx * layer_density(dx, k.support));
-    params_.fit_radius = static_cast<float>(kFitRadius * dx);
-    params_.smooth_radius = static_cast<float>(kSmoothRadius * dx);
+    params_.fit_radius = static_cast<float>(tension::kFitRadius * dx);
+    params_.smooth_radius = static_cast<float>(tension::kSmoothRadius * dx);
   }
   std::vector<float> adhesion = c.adhesion;
   if (adhesion.empty()) adhesion.push_back(0.0f);

@@ -50,6 +50,13 @@ inline double akinci_cohesion_shape(double q) {
   return q > 1.0 ? 0.0 : (q > 0.5 ? a : 2.0 * a - 1.0 / 64.0);
 }
 
+/* brackbill1992: the radius, in spacings, of the patch of surface points a particle's quadric is fitted to
+ * (sim/tension_stage.cpp; its walk reaches ceil(3.5 dx / H) cells each way), and of the average of the fitted
+ * curvatures. Measured with numpy on lattice spheres of R = 6-16 spacings jittered by 0.1 spacing
+ * (docs/TENSION.md): the area-weighted mean of kappa R came within 10 % of 2; at the support (2 spacings) the
+ * fits were too few to hold. */
+constexpr double kFitRadius = 3.5, kSmoothRadius = 3.0;
+
 /* THAW_AKINCI_ADHESION in double. */
 inline double akinci_adhesion_shape(double q) {
   return std::pow(std::max(-4.0 * q * q + 6.0 * q - 2.0, 0.0), 0.25);

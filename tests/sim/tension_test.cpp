@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "sim/error.h"
 #include "sim/solver.h"
 #include "sim/tension_stage.h"
 #include "tests/test_support.h"
@@ -154,6 +155,29 @@ TEST_F(TensionTest, TensionPullsALongBlockRound) {
       else
         EXPECT_LT(end / start, 0.5) << pressure;
     }
+}
+
+// brackbill1992's fits walk 5 x 5 x 5 cells at H = 2 spacings: a periodic axis shorter than that is refused
+// by name, and one long enough is taken.
+TEST(TensionScene, TheSurfaceFitNeedsRoomAroundAPeriodicAxis) {
+  Json doc = block_scene({{"model", "brackbill1992"}});
+  doc["solver"]["periodic"] = {"y"};
+  doc["domain"] = Json::parse(R"({"min": [-0.02, -0.004, -0.02], "max": [0.02, 0.004, 0.02]})");
+  doc["fluids"][0]["box"] = Json::parse(R"({"min": [-0.005, -0.004, -0.01], "max": [0.005, 0.004, 0.01]})");
+  try {
+    scene_from_json(doc);
+    ADD_FAILURE() << "an 8 mm periodic axis (4 supports) was taken";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path(), "tension.model");
+    EXPECT_NE(std::string(e.what()).find("0.01 m"), std::string::npos) << e.what();
+  }
+  doc["domain"]["min"][1] = -0.005;
+  doc["domain"]["max"][1] = 0.005;
+  EXPECT_NO_THROW(scene_from_json(doc));
+  doc["tension"]["model"] = "akinci2013";
+  doc["domain"]["min"][1] = -0.004;
+  doc["domain"]["max"][1] = 0.004;
+  EXPECT_NO_THROW(scene_from_json(doc));
 }
 
 // brackbill1992 on a still drop of R = 8 spacings cut from the lattice: the first step's velocities are the
