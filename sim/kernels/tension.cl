@@ -78,6 +78,27 @@ kernel void tension_columns(global const uchar* phase, global const uchar* mater
   global const float* Y = soa + stride;      \
   global const float* Z = soa + 2 * stride;
 
+/* sum_j V_j grad_shape(r / H) (x_i - x_j) over the neighbours within H, on lanes: the colour gradient
+ * sum_j V_j grad W_ij less the kernel's sigma / H^2 (akinci2013's normals, brackbill1992's). */
+float3 colour_gradient_sum(const float4 pi, const int4 c, const Grid g, global const uint* cell_start,
+                           global const float* X, global const float* Y, global const float* Z,
+                           global const float* V, const float H2, const float inv_H) {
+  floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f);
+  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+    const float4 pr = THAW_ROW_POS(g, c, pi);
+    for (uint j = jb; j < je; j += THAW_VW) {
+      const floatV dx = pr.x - vloadV(0, X + j), dy = pr.y - vloadV(0, Y + j), dz = pr.z - vloadV(0, Z + j);
+      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV s = select((floatV)(0.0f), vloadV(0, V + j) * grad_shape(sqrt(r2) * inv_H), in);
+      gx += s * dx;
+      gy += s * dy;
+      gz += s * dz;
+    }
+  }
+  return (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
+}
+
 #ifdef THAW_TENSION_AKINCI2013
 /* Akinci et al. 2013 eq. 3's C(r) = 32 / (pi H^3) c(q) on lanes, q = r / H (tension_params.h has it on the
  * host): attraction past H/2, repulsion close in. */
@@ -97,21 +118,7 @@ kernel void tension_normals(global const float4* pos, global const uchar* phase,
   if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
   const uint stride = P.stride;
   TENSION_START
-  global const float* V = col + COL_V * stride;
-  floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
-    const float4 pr = THAW_ROW_POS(g, c, pi);
-    for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pr.x - vloadV(0, X + j), dy = pr.y - vloadV(0, Y + j), dz = pr.z - vloadV(0, Z + j);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-      const floatV s = select((floatV)(0.0f), vloadV(0, V + j) * grad_shape(sqrt(r2) * inv_H), in);
-      gx += s * dx;
-      gy += s * dy;
-      gz += s * dz;
-    }
-  }
-  const float3 n = H * THAW_SIGMA(H) * inv_H * inv_H * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
+  const float3 n = H * THAW_SIGMA(H) * inv_H * inv_H * colour_gradient_sum(pi, c, g, cell_start, X, Y, Z, col + COL_V * stride, H2, inv_H);
   col[(COL_NX + 0) * stride + i] = n.x;
   col[(COL_NX + 1) * stride + i] = n.y;
   col[(COL_NX + 2) * stride + i] = n.z;
@@ -143,20 +150,7 @@ kernel void tension_surface(global const float4* pos, global const uchar* phase,
   const uint stride = P.stride;
   TENSION_START
   global const float* V = col + COL_V * stride;
-  floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f);
-  FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
-    const float4 pr = THAW_ROW_POS(g, c, pi);
-    for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pr.x - vloadV(0, X + j), dy = pr.y - vloadV(0, Y + j), dz = pr.z - vloadV(0, Z + j);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-      const floatV s = select((floatV)(0.0f), vloadV(0, V + j), in) * grad_shape(sqrt(r2) * inv_H);
-      gx += s * dx;
-      gy += s * dy;
-      gz += s * dz;
-    }
-  }
-  const float3 grad = THAW_SIGMA(H) * inv_H * inv_H * (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
+  const float3 grad = THAW_SIGMA(H) * inv_H * inv_H * colour_gradient_sum(pi, c, g, cell_start, X, Y, Z, V, H2, inv_H);
   const float g_len = length(grad);
   if (!(g_len > 0.0f)) return;
   const float3 n = -grad / g_len;
