@@ -118,7 +118,8 @@ kernel void tension_normals(global const float4* pos, global const uchar* phase,
   if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
   const uint stride = P.stride;
   TENSION_START
-  const float3 n = H * THAW_SIGMA(H) * inv_H * inv_H * colour_gradient_sum(pi, c, g, cell_start, X, Y, Z, col + COL_V * stride, H2, inv_H);
+  const float3 n = H * THAW_SIGMA(H) * inv_H * inv_H *
+                   colour_gradient_sum(pi, c, g, cell_start, X, Y, Z, col + COL_V * stride, H2, inv_H);
   col[(COL_NX + 0) * stride + i] = n.x;
   col[(COL_NX + 1) * stride + i] = n.y;
   col[(COL_NX + 2) * stride + i] = n.z;
@@ -131,10 +132,10 @@ kernel void tension_normals(global const float4* pos, global const uchar* phase,
  * (docs/SURFACE.md), so the force on a patch of surface is sigma kappa times its area and a still drop holds
  * Laplace's jump 2 sigma / R. The colour c counts water, ice and solids as inside, so a face against a wall
  * or ice carries no tension; the water holds to them by Akinci et al. 2013's adhesion. Taking the divergence
- * of the normals for kappa, as Brackbill et al. do, is too noisy on particles (docs/TENSION.md): kappa here is
- * the mean curvature of a quadric fitted by least squares to the surface points near the particle (as the
- * height functions of volume-of-fluid codes do on cells), the outer layer's particles moved out half a spacing
- * along their normals. */
+ * of the normals for kappa, as Brackbill et al. do, is too noisy on particles (docs/TENSION.md): kappa here
+ * is the mean curvature of a quadric fitted by least squares to the surface points near the particle (as the
+ * height functions of volume-of-fluid codes do on cells), the outer layer's particles moved out half a
+ * spacing along their normals. */
 
 /* Each water particle's colour gradient over the inside, grad c_i = sum_j v_j grad W_ij, and its outward
  * normal n_i = -grad c / |grad c|. A particle is on the outer layer where no
@@ -150,7 +151,8 @@ kernel void tension_surface(global const float4* pos, global const uchar* phase,
   const uint stride = P.stride;
   TENSION_START
   global const float* V = col + COL_V * stride;
-  const float3 grad = THAW_SIGMA(H) * inv_H * inv_H * colour_gradient_sum(pi, c, g, cell_start, X, Y, Z, V, H2, inv_H);
+  const float3 grad =
+      THAW_SIGMA(H) * inv_H * inv_H * colour_gradient_sum(pi, c, g, cell_start, X, Y, Z, V, H2, inv_H);
   const float g_len = length(grad);
   if (!(g_len > 0.0f)) return;
   const float3 n = -grad / g_len;
@@ -238,7 +240,8 @@ kernel void tension_curvature(global const float4* pos, global const uchar* phas
       const float u = dot(o, e1) * inv_dx, v = dot(o, e2) * inv_dx, h = dot(o, ni) * inv_dx;
       const float w = fmax(1.0f - (u * u + v * v) / rf2_dx, 0.0f) + 1e-3f;
       const float q = sqrt(u * u + v * v) / h2d;
-      density += q < 0.5f ? 6.0f * q * q * (q - 1.0f) + 1.0f : (q < 1.0f ? 2.0f * (1.0f - q) * (1.0f - q) * (1.0f - q) : 0.0f);
+      const float qa = 1.0f - q;
+      density += q < 0.5f ? 6.0f * q * q * (q - 1.0f) + 1.0f : (q < 1.0f ? 2.0f * qa * qa * qa : 0.0f);
       const float b[6] = {u * u, u * v, v * v, u, v, 1.0f};
       int k = 0;
       for (int r = 0; r < 6; ++r) {
