@@ -12,8 +12,8 @@ namespace thaw {
 namespace {
 
 constexpr std::size_t kColumns = 7;  // tension.cl's column block: W, R, V, B, NX, NY, NZ
-// brackbill1992's block adds DX, DY, DZ, A, K, K2, OK, BAND.
-constexpr std::size_t kCsfColumns = 15;
+// brackbill1992's block adds A, K, K2, OK, BAND.
+constexpr std::size_t kCsfColumns = 12;
 
 // int_0^1 q^p f(q) dq by Simpson's rule on 2000 intervals per half (the shapes have a kink at q = 1/2).
 double moment(double (*f)(double), int p) {
@@ -152,10 +152,10 @@ void TensionStage::run(const NeighbourView& nv, const cl::Buffer& accel) {
     set_args(k_curvature_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
              columns_);
     launch(q, k_curvature_, layout_.n);
-    // twice: K into K2, K2 back into K (tension.cl's columns 11 and 12)
-    for (const cl_int from : {11, 12}) {
+    // twice: K into K2, then K2 back into K
+    for (const cl_int into_k2 : {1, 0}) {
       set_args(k_smooth_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
-               columns_, from, cl_int(23 - from));
+               columns_, into_k2);
       launch(q, k_smooth_, layout_.n);
     }
   }

@@ -94,12 +94,16 @@ float4 row_image(const Grid g, const int4 c, const int dz, const int dy, const f
  * deliberately simple: the walk's per-row cost is a large part of a pass (measured: trimming rows to
  * the cells that can hold a neighbour visits a quarter fewer candidates but made the density pass
  * slower; see docs/BENCHMARKS.md). */
-#define FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je)                                        \
-  for (int dz_ = -THAW_REACH; dz_ <= THAW_REACH; ++dz_)                                         \
-    for (int dy_ = -THAW_REACH; dy_ <= THAW_REACH; ++dy_)                                       \
-      for (int row_ = neighbour_row(g, c, dz_, dy_); row_ >= 0; row_ = -1)                      \
-        for (uint jb = (cell_start)[row_ + max((c).x - THAW_REACH, 0)],                         \
-                  je = (cell_start)[row_ + min((c).x + THAW_REACH, (g).nx - 1) + 1], once_ = 1; \
+#define FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) \
+  FOR_EACH_ROW_WITHIN(g, cell_start, c, THAW_REACH, jb, je)
+
+/* The same over the rows within `reach` cells of c (a pass whose patch reaches past the support). */
+#define FOR_EACH_ROW_WITHIN(g, cell_start, c, reach, jb, je)                                 \
+  for (int dz_ = -(reach); dz_ <= (reach); ++dz_)                                            \
+    for (int dy_ = -(reach); dy_ <= (reach); ++dy_)                                          \
+      for (int row_ = neighbour_row(g, c, dz_, dy_); row_ >= 0; row_ = -1)                   \
+        for (uint jb = (cell_start)[row_ + max((c).x - (reach), 0)],                         \
+                  je = (cell_start)[row_ + min((c).x + (reach), (g).nx - 1) + 1], once_ = 1; \
              once_; once_ = 0)
 
 /* SIMD lanes over neighbour candidates: the neighbour passes (density.cl, forces.cl) read THAW_VW

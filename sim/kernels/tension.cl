@@ -13,7 +13,6 @@
  *      there are none;
  * and for brackbill1992 (tension_surface, tension_curvature, tension_smooth), where V is instead the colour's
  * rest volume dx^3 of every inside particle (water, ice, solids; air: 0):
- *   DX, DY, DZ: from the particle to its surface point, n_i dx / 2 on the outer layer;
  *   A: an outer-layer particle's share of the surface area (0 elsewhere);
  *   K, K2: the curvature, fitted and averaged (two columns to average from one into the other);
  *   OK: 1 where the fit held;
@@ -24,12 +23,11 @@
 #define COL_V 2
 #define COL_B 3
 #define COL_NX 4
-#define COL_DX 7
-#define COL_A 10
-#define COL_K 11
-#define COL_K2 12
-#define COL_OK 13
-#define COL_BAND 14
+#define COL_A 7
+#define COL_K 8
+#define COL_K2 9
+#define COL_OK 10
+#define COL_BAND 11
 
 kernel void tension_columns(global const uchar* phase, global const uchar* material, global const float4* pos,
                             global const float* density, global const float* adhesion, const TensionParams P,
@@ -65,7 +63,7 @@ kernel void tension_columns(global const uchar* phase, global const uchar* mater
   col[(COL_NX + 1) * stride + i] = 0.0f;
   col[(COL_NX + 2) * stride + i] = 0.0f;
 #ifdef THAW_TENSION_BRACKBILL1992
-  for (int k = COL_DX; k <= COL_BAND; ++k) col[k * stride + i] = 0.0f;
+  for (int k = COL_A; k <= COL_BAND; ++k) col[k * stride + i] = 0.0f;
 #endif
 }
 
@@ -171,31 +169,22 @@ kernel void tension_surface(global const float4* pos, global const uchar* phase,
       covered = r2 < H2 && up > 0.0f && up * up > 0.5f * r2;
     }
   }
-  if (covered) return;
-  const float d = 0.5f * P.spacing;
-  col[(COL_DX + 0) * stride + i] = n.x * d;
-  col[(COL_DX + 1) * stride + i] = n.y * d;
-  col[(COL_DX + 2) * stride + i] = n.z * d;
-  col[COL_BAND * stride + i] = 1.0f;
+  if (!covered) col[COL_BAND * stride + i] = 1.0f;
 }
 
-/* Visits the rows of cells within THAW_FIT_REACH of cell c (the fit's and the average's patches reach past
- * the support), as FOR_EACH_NEIGHBOUR_ROW does within THAW_REACH. */
-#define FOR_EACH_FIT_ROW(g, cell_start, c, jb, je)                                                 \
-  for (int dz_ = -THAW_FIT_REACH; dz_ <= THAW_FIT_REACH; ++dz_)                                    \
-    for (int dy_ = -THAW_FIT_REACH; dy_ <= THAW_FIT_REACH; ++dy_)                                  \
-      for (int row_ = neighbour_row(g, c, dz_, dy_); row_ >= 0; row_ = -1)                         \
-        for (uint jb = (cell_start)[row_ + max((c).x - THAW_FIT_REACH, 0)],                        \
-                  je = (cell_start)[row_ + min((c).x + THAW_FIT_REACH, (g).nx - 1) + 1], once_ = 1; \
-             once_; once_ = 0)
+/* The rows of cells within THAW_FIT_REACH of cell c: the fit's and the average's patches reach past the
+ * support (grid_common.h). */
+#define FOR_EACH_FIT_ROW(g, cell_start, c, jb, je) FOR_EACH_ROW_WITHIN(g, cell_start, c, THAW_FIT_REACH, jb, je)
 
-/* Surface particle j's surface point less particle i's, s_j - s_i = (x_j - x_i) + D_j - D_i, with pr as
- * particle i's position that row sees (minimum image). */
+/* Outer-layer particle j's surface point less particle i's, each half a spacing out along its normal:
+ * s_j - s_i = (x_j - x_i) + (dx / 2)(n_j - n_i), with pr as particle i's position that row sees (minimum
+ * image). */
 float3 surface_offset(const float4 pr, const uint j, global const float* X, global const float* Y,
-                      global const float* Z, global const float* col, const uint stride, const float3 di) {
-  const float3 dj = (float3)(col[(COL_DX + 0) * stride + j], col[(COL_DX + 1) * stride + j],
-                             col[(COL_DX + 2) * stride + j]);
-  return (float3)(X[j] - pr.x, Y[j] - pr.y, Z[j] - pr.z) + dj - di;
+                      global const float* Z, global const float* col, const uint stride, const float3 ni,
+                      const float half_dx) {
+  const float3 nj = (float3)(col[(COL_NX + 0) * stride + j], col[(COL_NX + 1) * stride + j],
+                             col[(COL_NX + 2) * stride + j]);
+  return (float3)(X[j] - pr.x, Y[j] - pr.y, Z[j] - pr.z) + half_dx * (nj - ni);
 }
 
 /* kappa_i: the mean curvature at s_i of the quadric h = a u^2 + b u v + c v^2 + d u + e v + f fitted by
@@ -214,8 +203,7 @@ kernel void tension_curvature(global const float4* pos, global const uchar* phas
   TENSION_START
   const float3 ni = (float3)(col[(COL_NX + 0) * stride + i], col[(COL_NX + 1) * stride + i],
                              col[(COL_NX + 2) * stride + i]);
-  const float3 di = (float3)(col[(COL_DX + 0) * stride + i], col[(COL_DX + 1) * stride + i],
-                             col[(COL_DX + 2) * stride + i]);
+  const float half_dx = 0.5f * P.spacing;
   /* a tangent frame: e1 across the axis n_i leans least towards */
   const float3 ax = fabs(ni.x) < 0.6f ? (float3)(1.0f, 0.0f, 0.0f) : (float3)(0.0f, 1.0f, 0.0f);
   const float3 e1 = normalize(cross(ni, ax)), e2 = cross(ni, e1);
@@ -235,7 +223,7 @@ kernel void tension_curvature(global const float4* pos, global const uchar* phas
     for (uint j = jb; j < je; ++j) {
       if (!(BAND[j] > 0.0f)) continue;
       if (NX[j] * ni.x + NY[j] * ni.y + NZ[j] * ni.z <= 0.5f) continue;
-      const float3 o = surface_offset(pr, j, X, Y, Z, col, stride, di);
+      const float3 o = surface_offset(pr, j, X, Y, Z, col, stride, ni, half_dx);
       if (dot(o, o) >= rf2) continue;
       const float u = dot(o, e1) * inv_dx, v = dot(o, e2) * inv_dx, h = dot(o, ni) * inv_dx;
       const float w = fmax(1.0f - (u * u + v * v) / rf2_dx, 0.0f) + 1e-3f;
@@ -302,7 +290,7 @@ kernel void tension_curvature(global const float4* pos, global const uchar* phas
  * column `to`. */
 kernel void tension_smooth(global const float4* pos, global const uchar* phase, global const float* soa,
                            global const uint* cell_start, const Grid g, const TensionParams P,
-                           global float* col, const int from, const int to) {
+                           global float* col, const int into_k2) {
   const uint i = get_global_id(0);
   if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
   const uint stride = P.stride;
@@ -310,6 +298,7 @@ kernel void tension_smooth(global const float4* pos, global const uchar* phase, 
   global const float* A = col + COL_A * stride;
   if (!(OK[i] > 0.0f)) return;
   TENSION_START
+  const int from = into_k2 ? COL_K : COL_K2, to = into_k2 ? COL_K2 : COL_K;
   global const float* K = col + from * stride;
   global const float* NX = col + (COL_NX + 0) * stride;
   global const float* NY = col + (COL_NX + 1) * stride;
