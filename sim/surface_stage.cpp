@@ -53,9 +53,16 @@ SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields
   inside_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
   if (model_ == ExposedArea::Orthmann2013) {
     k_area_ = cl::Kernel(program, "surface_area");
-    delta_lanes_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
-    cl.queue().enqueueFillBuffer(delta_lanes_, 0.0f, 0, padded);
+  } else {
+    k_layer_ = cl::Kernel(program, "surface_layer");
+    k_project_ = cl::Kernel(program, "surface_project");
   }
+  delta_lanes_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
+  cl.queue().enqueueFillBuffer(delta_lanes_, 0.0f, 0, padded);
+  // three padded blocks: brackbill1992's layer normals (only a placeholder for orthmann2013)
+  const std::size_t normals = model_ == ExposedArea::Orthmann2013 ? 4 : padded * 3;
+  layer_n_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, normals);
+  cl.queue().enqueueFillBuffer(layer_n_, 0.0f, 0, normals);
 
   const double dx = scene.spacing;
   params_.support = k.support;
@@ -81,16 +88,23 @@ void SurfaceStage::run(const NeighbourView& nv) {
   surface::SurfaceParams P = params_;
   P.n = static_cast<cl_uint>(layout_.n);
   auto& q = cl_.queue();
-  const bool orthmann = model_ == ExposedArea::Orthmann2013;  // brackbill1992 never writes delta_lanes
   set_args(k_inside_, store_[core_.phase], inside_, P.n, nv.stride);
   launch(q, k_inside_, nv.stride);
   set_args(k_delta_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid, P,
-           nv.stride, store_[normal_], store_[delta_], orthmann ? delta_lanes_ : inside_, store_[area_]);
+           nv.stride, store_[normal_], store_[delta_], delta_lanes_, store_[area_], layer_n_);
   launch(q, k_delta_, layout_.n);
-  if (orthmann) {
+  if (model_ == ExposedArea::Orthmann2013) {
     set_args(k_area_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid, P,
              nv.stride, delta_lanes_, store_[area_]);
     launch(q, k_area_, layout_.n);
+  } else {
+    // delta_lanes_ holds the outer layer's marks here
+    set_args(k_layer_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid,
+             P, nv.stride, store_[normal_], delta_lanes_, layer_n_, store_[area_]);
+    launch(q, k_layer_, layout_.n);
+    set_args(k_project_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,
+             nv.stride, store_[normal_], delta_lanes_, layer_n_, store_[delta_], store_[area_]);
+    launch(q, k_project_, layout_.n);
   }
 }
 

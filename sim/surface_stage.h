@@ -37,10 +37,11 @@ class SurfaceStage {
   ExposedArea model_;
   surface::SurfaceParams params_{};  // all but n, from the scene and the kernel at construction
   ParticleStore::Field area_ = 0, normal_ = 0, delta_ = 0;
-  cl::Kernel k_inside_, k_delta_, k_area_;
-  // Padded blocks of stride floats the neighbour loops read on lanes: who is inside, and (orthmann2013's eq 7
-  // only) the deltas.
-  cl::Buffer inside_, delta_lanes_;
+  cl::Kernel k_inside_, k_delta_, k_area_, k_layer_, k_project_;
+  // Padded blocks of stride floats the neighbour loops read on lanes: who is inside; orthmann2013's deltas
+  // for its eq 7, or brackbill1992's outer-layer marks; and brackbill1992's layer normals, three blocks
+  // (surface.cl).
+  cl::Buffer inside_, delta_lanes_, layer_n_;
 };
 
 }  // namespace thaw

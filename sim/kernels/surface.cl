@@ -46,26 +46,30 @@ kernel void surface_inside(global const uchar* phase, global float* inside, cons
  * grad c_i = sum_j v_j grad W_ij, the covariance C_i (eq. 8) and the neighbour count; then the delta:
  *   orthmann2013: eq. 6's half-sided tent of phi, delta_max = 1/d where the neighbourhood is singular;
  *   brackbill1992: the colour gradient's |grad c_i| (Brackbill, Kothe & Zemach 1992's surface delta),
- *     scaled so a flat face on the scene's lattice sums to its area; where the neighbourhood is singular, a
+ *     scaled so a flat face on the scene's lattice sums to its area (surface_project then keeps only its part
+ *     along the outer layer's normal, and only near the layer); where the neighbourhood is singular, a
  *     sheet's 2 / t (t its thickness from C's least eigenvalue: both faces) or, for a filament or a lone
  *     particle, the area of a sphere of its volume.
  * In singular neighbourhoods delta relaxes at eq. 9's rate from its last value (NaN: none yet). The sums
- * run on lanes (grid_common.h) with the kernel's normalisation factored out. delta_lanes (orthmann2013
- * only): delta again, in a padded block for surface_area's lanes. */
+ * run on lanes (grid_common.h) with the kernel's normalisation factored out. delta_lanes: orthmann2013,
+ * delta again, in a padded block for surface_area's lanes; brackbill1992, the layer marks surface_layer and
+ * surface_project read (2 where singular, else 0), and layer_n the layer's normals in three padded blocks (x,
+ * y, z; 0 off the layer) that surface_project reads on lanes. */
 kernel void surface_delta(global const float4* pos, global const uchar* phase, global const float* soa,
                           global const float* inside, global const uint* cell_start, const Grid g,
                           const SurfaceParams P, const uint stride, global float4* normal, global float* delta,
-                          global float* delta_lanes, global float* area) {
+                          global float* delta_lanes, global float* area, global float* layer_n) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uchar ph = phase[i];
   if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) {
     normal[i] = (float4)(0.0f);
     delta[i] = 0.0f;
-#ifdef THAW_AREA_ORTHMANN2013
     delta_lanes[i] = 0.0f;
-#endif
     area[i] = 0.0f;
+#ifdef THAW_AREA_BRACKBILL1992
+    layer_n[i] = layer_n[stride + i] = layer_n[2 * stride + i] = 0.0f;
+#endif
     return;
   }
   SURFACE_START(pos, soa, stride)
@@ -160,6 +164,12 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
   delta[i] = di;
 #ifdef THAW_AREA_ORTHMANN2013
   delta_lanes[i] = di;
+#else
+  delta_lanes[i] = singular ? 2.0f : 0.0f; /* surface_layer's marks: 2, singular (kept as it is) */
+  const float3 ln = singular ? n : (float3)(0.0f); /* the layer's normals, on lanes (surface_layer) */
+  layer_n[i] = ln.x;
+  layer_n[stride + i] = ln.y;
+  layer_n[2 * stride + i] = ln.z;
 #endif
   normal[i] = (float4)(n, phi);
   area[i] = v * di; /* orthmann2013: replaced by eq. 7 in surface_area */
@@ -188,5 +198,83 @@ kernel void surface_area(global const float4* pos, global const uchar* phase, gl
     }
   }
   area[i] = P.volume * lanes_sum(sdw) / lanes_sum(sw);
+}
+#endif
+
+#ifdef THAW_AREA_BRACKBILL1992
+/* The least area, in spacings squared, of a particle surface_layer tests: a flat face's outer layer carries
+ * about 0.6 of its share, and below this the test only finds the bulk covered (in `default` at 0.3 s, 0.1 and
+ * 0.2 gave the same heat to 1e-4, and halved the stage's time against no threshold). */
+#define THAW_LAYER_MIN_AREA 0.1f
+
+/* brackbill1992's outer layer: a water or ice particle whose neighbourhood is not singular is on it where no
+ * inside neighbour lies within 45 degrees of its outward normal (the cone of Marrone et al. 2010's
+ * free-surface test): layer 1. Particles already marked singular (2) stay so. Inside disordered water the
+ * colour gradient is noise and its normal random, but some neighbour always lies in that cone: on lattices
+ * jittered by up to 0.25 spacing no bulk particle passed (numpy, docs/SURFACE.md). */
+kernel void surface_layer(global const float4* pos, global const uchar* phase, global const float* soa,
+                          global const float* inside, global const uint* cell_start, const Grid g,
+                          const SurfaceParams P, const uint stride, global const float4* normal,
+                          global float* layer, global float* layer_n, global const float* area) {
+  const uint i = get_global_id(0);
+  if (i >= P.n || layer[i] != 0.0f) return;
+  const uchar ph = phase[i];
+  if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) return;
+  const float3 n = normal[i].xyz;
+  if (!(dot(n, n) > 0.0f) || !(area[i] > THAW_LAYER_MIN_AREA * P.spacing * P.spacing)) return;
+  SURFACE_START(pos, soa, stride)
+  int covered = 0;
+  FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
+    for (uint j = jb; j < je && !covered; ++j) {
+      if (!(inside[j] > 0.0f) || j == i) continue;
+      const float3 o = (float3)(THAW_WRAP(X[j] - pi.x, P.period_x), THAW_WRAP(Y[j] - pi.y, P.period_y),
+                                THAW_WRAP(Z[j] - pi.z, P.period_z));
+      const float r2 = dot(o, o), up = dot(o, n);
+      covered = r2 < H2 && up > 0.0f && up * up > 0.5f * r2;
+    }
+  }
+  if (covered) return;
+  layer[i] = 1.0f;
+  layer_n[i] = n.x;
+  layer_n[stride + i] = n.y;
+  layer_n[2 * stride + i] = n.z;
+}
+
+/* brackbill1992's areas where the neighbourhood is not singular: the colour gradient's component along the
+ * outer layer's normal there, a_i = v s max(-grad c_i . nbar_i, 0), with nbar_i the mean of the normals of
+ * the layer's particles within the support (weights 1 - r / H, i itself among them if it is on the layer),
+ * and 0 where none is that near. Both cut the colour gradient's noise inside disordered water, which is not
+ * surface: the gate removes it away from the surface, the projection its random directions near it. On an
+ * exact lattice every particle with a colour gradient lies within a support of the layer, so the sum there
+ * moves only by the projection (numpy: spheres of 10 and 20 spacings, -1.5 to -1.8 %). */
+kernel void surface_project(global const float4* pos, global const uchar* phase, global const float* soa,
+                            global const uint* cell_start, const Grid g, const SurfaceParams P,
+                            const uint stride, global const float4* normal, global const float* layer,
+                            global const float* layer_n, global float* delta, global float* area) {
+  const uint i = get_global_id(0);
+  if (i >= P.n || layer[i] > 1.5f) return;
+  const uchar ph = phase[i];
+  if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) return;
+  SURFACE_START(pos, soa, stride)
+  global const float* LX = layer_n;
+  global const float* LY = layer_n + stride;
+  global const float* LZ = layer_n + 2 * stride;
+  floatV nx = (floatV)(0.0f), ny = (floatV)(0.0f), nz = (floatV)(0.0f);
+  FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
+    for (uint j = jb; j < je; j += THAW_VW) {
+      SURFACE_LANES(pi, j)
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      const floatV w = select((floatV)(0.0f), 1.0f - sqrt(r2) * inv_H, in);
+      nx += w * vloadV(0, LX + j);
+      ny += w * vloadV(0, LY + j);
+      nz += w * vloadV(0, LZ + j);
+    }
+  }
+  const float3 nbar = (float3)(lanes_sum(nx), lanes_sum(ny), lanes_sum(nz));
+  const float len = length(nbar);
+  const float cosine = len > 0.0f ? fmax(dot(normal[i].xyz, nbar) / len, 0.0f) : 0.0f;
+  const float di = delta[i] * cosine; /* delta = s |grad c_i| here, and grad c_i = -|grad c_i| n_i */
+  delta[i] = di;
+  area[i] = P.volume * di;
 }
 #endif
