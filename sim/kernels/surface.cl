@@ -166,7 +166,7 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
   delta_lanes[i] = di;
 #else
   delta_lanes[i] = singular ? 2.0f : 0.0f; /* surface_layer's marks: 2, singular (kept as it is) */
-  const float3 ln = singular ? n : (float3)(0.0f); /* the layer's normals, on lanes (surface_layer) */
+  const float3 ln = singular ? n : (float3)(0.0f); /* the layer's normals, for surface_project's lanes */
   layer_n[i] = ln.x;
   layer_n[stride + i] = ln.y;
   layer_n[2 * stride + i] = ln.z;
