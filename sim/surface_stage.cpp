@@ -56,13 +56,12 @@ SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields
   } else {
     k_layer_ = cl::Kernel(program, "surface_layer");
     k_project_ = cl::Kernel(program, "surface_project");
+    layer_n_ =
+        cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded * 3);  // the layer's normals: x, y, z blocks
+    cl.queue().enqueueFillBuffer(layer_n_, 0.0f, 0, padded * 3);
   }
   delta_lanes_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
   cl.queue().enqueueFillBuffer(delta_lanes_, 0.0f, 0, padded);
-  // three padded blocks: brackbill1992's layer normals (only a placeholder for orthmann2013)
-  const std::size_t normals = model_ == ExposedArea::Orthmann2013 ? 4 : padded * 3;
-  layer_n_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, normals);
-  cl.queue().enqueueFillBuffer(layer_n_, 0.0f, 0, normals);
 
   const double dx = scene.spacing;
   params_.support = k.support;
@@ -90,10 +89,13 @@ void SurfaceStage::run(const NeighbourView& nv) {
   auto& q = cl_.queue();
   set_args(k_inside_, store_[core_.phase], inside_, P.n, nv.stride);
   launch(q, k_inside_, nv.stride);
+  // orthmann2013's surface_delta neither reads nor writes its last argument, the layer's normals
+  const bool orthmann = model_ == ExposedArea::Orthmann2013;
   set_args(k_delta_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid, P,
-           nv.stride, store_[normal_], store_[delta_], delta_lanes_, store_[area_], layer_n_);
+           nv.stride, store_[normal_], store_[delta_], delta_lanes_, store_[area_],
+           orthmann ? delta_lanes_ : layer_n_);
   launch(q, k_delta_, layout_.n);
-  if (model_ == ExposedArea::Orthmann2013) {
+  if (orthmann) {
     set_args(k_area_, store_[core_.position], store_[core_.phase], nv.soa, inside_, nv.cell_start, nv.grid, P,
              nv.stride, delta_lanes_, store_[area_]);
     launch(q, k_area_, layout_.n);
