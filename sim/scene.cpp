@@ -295,6 +295,7 @@ HeatSettings heat_settings_from_json(const Json& doc) {
   h.exposed_area = choice_of<ExposedArea>(
       doc["heat"]["exposed_area"],
       {ExposedArea::Iwasaki2010, ExposedArea::Orthmann2013, ExposedArea::Brackbill1992});
+  h.area_interval = doc["heat"]["area_interval"].get<int>();
   h.ambient_temperature = doc["ambient"]["temperature"].get<double>();
   h.ambient_coefficient = doc["ambient"]["heat_transfer_coefficient"].get<double>();
   h.wall_coefficient = doc["domain"]["wall_heat"]["coefficient"].get<double>();

@@ -191,7 +191,8 @@ struct HeatSettings {
   // Heat steps a flow step may hold: where conduction (times time_scale) limits the step, the heat pass
   // runs up to this many sub-steps at fixed positions and the flow takes the longer step.
   int max_substeps = 1;
-  ExposedArea exposed_area = ExposedArea::Iwasaki2010;
+  ExposedArea exposed_area = ExposedArea::Brackbill1992;
+  int area_interval = 4;              // flow steps between the surface stage's area updates
   double ambient_temperature = 20.0;  // [°C]
   double ambient_coefficient = 10.0;  // h [W/m^2/K]
   double wall_coefficient = 0.0;      // U through the tank walls [W/m^2/K]

@@ -321,7 +321,16 @@ const Field& scene_schema() {
                          "al. 2013's thin-sheet handling; orthmann2013 = Orthmann et al. 2013 eqs 2-9 as the "
                          "paper has them; iwasaki2010 = (6 - n_i) / 6 of a voxel's six faces, n_i the "
                          "particles within 1.2 spacings (Iwasaki et al. 2010 sec. 4)")
-                      .def("iwasaki2010"),
+                      .def("brackbill1992"),
+                  integer("area_interval",
+                          "Flow steps between updates of the surface stage's areas (brackbill1992, "
+                          "orthmann2013; docs/SURFACE.md): a step moves the surface a fraction of a spacing, "
+                          "and the areas stay with their particles in between (saved in state files, so a "
+                          "resumed run goes on as it was). 1: every step. Orthmann's eq 9 relaxes once an "
+                          "update")
+                      .def(4)
+                      .at_least(1)
+                      .at_most(64),
               },
               "Heat transfer and phase change (Iwasaki et al. 2010; docs/ARCHITECTURE.md Numerics)."),
           object(

@@ -370,6 +370,9 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   HostParticles init = p;
   const bool psi_missing = give_boundaries_lattice_mass(init, scene_, k_.rest_density);
   upload(init);
+  // Areas a state (or the solver's own growth) brings are the ones its run had: they serve until the next
+  // update (heat.area_interval), as they would have.
+  surface_done_ = surface_ && init.column("surface_area") != nullptr;
   if (psi_missing && scene_.solver.boundary_volume == BoundaryVolume::Akinci2012) compute_boundary_psi(opts);
   if (rigid_ && !st.rigid_bodies.empty()) {
     if (!p.column("body") || !p.column("body_offset"))
@@ -620,8 +623,11 @@ NeighbourView Solver::neighbours() const { return grid_->view(); }
 
 void Solver::heat_stages(double dt) {
   timed(Stage::Photons, [&] { trace_photons(dt); });
-  // Without flow the particles never move: the first pass's areas serve the whole run.
-  if (surface_ && (scene_.solver.flow || !surface_done_)) {
+  // Without flow the particles never move: the first pass's areas serve the whole run. With flow they are
+  // updated every heat.area_interval steps (counted from step 0, so a resumed run updates when the straight
+  // one did).
+  const auto interval = static_cast<std::uint64_t>(scene_.heat.area_interval);
+  if (surface_ && (!surface_done_ || (scene_.solver.flow && steps_ % interval == 0))) {
     timed(Stage::Surface, [&] { surface_->run(neighbours()); });
     surface_done_ = true;
   }
@@ -749,7 +755,10 @@ void Solver::warm_up() {
   choose_time_step();
   integrate(0.0);
   // dt = 0 adds no heat; the budget's sums of zero leave it unchanged.
-  if (surface_) surface_->run(neighbours());
+  if (surface_ && !surface_done_) {
+    surface_->run(neighbours());
+    surface_done_ = true;
+  }
   if (heat_) heat_->warm_up(neighbours(), budget_);
   cl_.queue().finish();
 }

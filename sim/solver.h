@@ -240,7 +240,7 @@ class Solver {
   std::unique_ptr<HeatStage> heat_;
   std::unique_ptr<SurfaceStage> surface_;  // only when heat_ takes its exposed areas from it
   std::unique_ptr<TensionStage> tension_;  // only with flow and tension.model other than none
-  bool surface_done_ = false;              // without flow the particles never move: one pass serves the run
+  bool surface_done_ = false;  // the areas are there: computed in this run, or brought by its state
   std::string heat_reason_;
   std::vector<Float2> fixed_enthalpy_;
   std::vector<thermal::MaterialThermal> table_;

@@ -31,7 +31,10 @@ SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields
                            const SolverConstants& k, const std::string& build_options,
                            const ParticleLayout& layout)
     : cl_(cl), store_(store), core_(core), scene_(scene), layout_(layout), model_(scene.heat.exposed_area) {
-  area_ = store.add({"surface_area", FieldType::Float32, 1, false, true});
+  // Saved where the areas outlive a step (heat.area_interval > 1 in a flowing scene), so a resumed run
+  // reads the areas the straight run had.
+  area_ = store.add(
+      {"surface_area", FieldType::Float32, 1, scene.solver.flow && scene.heat.area_interval > 1, true});
   normal_ = store.add({"surface_normal", FieldType::Float32, 4, false, true});
   // Saved, so a resumed run relaxes from where it stopped; NaN (none yet) where a state has none.
   delta_ = store.add({"surface_delta", FieldType::Float32, 1, true, false, nan_bits()});

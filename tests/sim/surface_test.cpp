@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "sim/kernels/sph_kernel.h"
 #include "sim/solver.h"
+#include "sim/state_file.h"
 #include "sim/validation/case.h"
 #include "tests/test_support.h"
 
@@ -119,6 +122,39 @@ TEST_F(SurfaceTest, DisorderedWaterInsideTheGlassIsNotSurface) {
   EXPECT_LT(small / now, 0.05) << small << " of " << now << " m^2";
   EXPECT_LT(now / start, 1.0);
   EXPECT_GT(now / start, 0.5);
+}
+
+// heat.area_interval (4 in `default`): the areas are updated at steps 0, 4, 8, ... and each particle keeps
+// its own in between, whatever the sort does; a run resumed at step 6 reads the areas of step 4 from its
+// state and goes on bit for bit.
+TEST_F(SurfaceTest, AreasAreUpdatedEveryIntervalAndAResumedRunGoesOnBitwise) {
+  const Scene scene = load_scene("default", {});
+  ASSERT_EQ(scene.heat.exposed_area, ExposedArea::Brackbill1992);
+  ASSERT_EQ(scene.heat.area_interval, 4);
+  testing::TempDir dir("surface-interval");
+  Solver straight(cl(), scene, initial_state(scene));
+  straight.warm_up();
+  const auto areas_by_id = [&] {
+    const HostParticles p = straight.particles();
+    const std::vector<float> a = straight.surface_areas();
+    std::vector<float> out(a.size(), 0.0f);
+    for (std::size_t i = 0; i < a.size(); ++i) out.at(p.id[i]) = a[i];
+    return out;
+  };
+  straight.step();  // step 0: updated
+  const std::vector<float> first = areas_by_id();
+  for (int i = 0; i < 3; ++i) straight.step();  // steps 1-3: kept
+  EXPECT_TRUE(areas_by_id() == first);
+  straight.step();  // step 4: updated where the particles are now
+  EXPECT_FALSE(areas_by_id() == first);
+  straight.step();
+  write_state_file(dir / "mid.state", straight.state());
+  for (int i = 0; i < 6; ++i) straight.step();
+  const std::string expected = testing::state_file_bytes(straight.state(), dir, "straight.state");
+  Solver resumed(cl(), scene, read_state_file(dir / "mid.state"));
+  resumed.warm_up();
+  while (resumed.steps() < straight.steps()) resumed.step();
+  EXPECT_TRUE(testing::state_file_bytes(resumed.state(), dir, "resumed.state") == expected);
 }
 
 TEST_F(SurfaceTest, TheSurfaceAreaCasesSphereAndSheetsHoldAtResolution20) {
