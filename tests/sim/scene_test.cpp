@@ -83,19 +83,21 @@ std::string file_error(const std::string& name, const std::string& text, std::st
 
 // ---- shipped scenes --------------------------------------------------------------------------------
 
+// The shipped scenes, and the benchmark scenes that docs/ tells users to run (bench/scenes/).
 TEST(Scene, EveryShippedConfigLoads) {
   int count = 0;
-  for (const auto& entry : fs::directory_iterator(kSource / "configs")) {
-    if (entry.path().extension() != ".json") continue;
-    SCOPED_TRACE(entry.path().string());
-    EXPECT_NO_THROW({
-      const Scene s = load_scene(entry.path().string());
-      EXPECT_FALSE(s.name.empty());
-      EXPECT_FALSE(s.fluids.empty() && s.ice.empty() && !s.has_air());
-    });
-    ++count;
-  }
-  EXPECT_GE(count, 4);
+  for (const char* dir : {"configs", "bench/scenes"})
+    for (const auto& entry : fs::directory_iterator(kSource / dir)) {
+      if (entry.path().extension() != ".json") continue;
+      SCOPED_TRACE(entry.path().string());
+      EXPECT_NO_THROW({
+        const Scene s = load_scene(entry.path().string());
+        EXPECT_FALSE(s.name.empty());
+        EXPECT_FALSE(s.fluids.empty() && s.ice.empty() && !s.has_air());
+      });
+      ++count;
+    }
+  EXPECT_GE(count, 5);
 }
 
 TEST(Scene, DefaultSceneResolvesByName) {
