@@ -242,6 +242,12 @@ int cmd_run(int argc, char** argv) {
                     m.air_min_temperature, m.air_max_temperature, m.air_mean_temperature, pressure);
       }
     }
+    if (!m.substances.is_null())
+      for (const auto& [name, v] : m.substances.items())
+        std::printf(
+            "substance %s: %.9g kg (outflow %.4g kg, inflow %.4g kg), closure %.3g kg (%.3g relative)\n",
+            name.c_str(), v["total"].get<double>(), v["outflow"].get<double>(), v["inflow"].get<double>(),
+            v["closure"].get<double>(), v["closure_relative"].get<double>());
     if (!m.pressure_solve.is_null()) {
       const Json& d = m.pressure_solve;
       std::printf("dfsph: %.2f density and %.2f divergence iterations per step (mean); last step's errors %.3g "

@@ -756,6 +756,7 @@ void Session::publish() {
       stats["inflow"] = {{"particles", in.particles}, {"mass", in.mass}, {"enthalpy", m.budget.inflow}};
     // DFSPH: the last step's solves and the run's counts, as the metrics carry them.
     if (Json d = pressure_solve_json(*solver_); !d.is_null()) stats["dfsph"] = std::move(d);
+    if (Json d = substances_json(*solver_); !d.is_null()) stats["substances"] = std::move(d);
     if (m.heat) {
       const EnergyBudget& b = m.budget;
       const double gross =

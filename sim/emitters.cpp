@@ -105,8 +105,10 @@ std::size_t EmitterStage::lay(const Nozzle& z, double open_for, double& pending,
 HostParticles EmitterStage::emit(double t, double dt, std::uint32_t& next_id) {
   HostParticles out;
   const std::size_t ne = scene_.emitters.size();
+  std::vector<std::size_t> first_of(ne + 1, 0);  // each emitter's first particle in `out`
   for (std::size_t k = 0; k < ne; ++k) {
     const Emitter& e = scene_.emitters[k];
+    first_of[k] = out.size();
     // The part of [t, t + dt] the tap pours in.
     const double stop = e.stop > 0 ? e.stop : std::numeric_limits<double>::infinity();
     const double open_for = std::min(t + dt, stop) - std::max(t, e.start);
@@ -114,6 +116,7 @@ HostParticles EmitterStage::emit(double t, double dt, std::uint32_t& next_id) {
     lay({e.position, e.direction, e.radius, e.speed, e.temperature, e.material, Phase::Water}, open_for,
         pending_[k], out, next_id);
   }
+  first_of[ne] = out.size();
   for (std::size_t k = 0; k < scene_.dryers.size(); ++k) {
     const Dryer& d = scene_.dryers[k];
     if (!d.blows_air() || !(dt > 0)) continue;
@@ -121,6 +124,12 @@ HostParticles EmitterStage::emit(double t, double dt, std::uint32_t& next_id) {
     owed_[k] += double(lay({d.position - pipe_length(scene_) * d.direction, d.direction,
                             0.5 * d.nozzle_diameter, d.speed, d.temperature, scene_.air.material, Phase::Air},
                            dt, pending_[ne + k], out, next_id));
+  }
+  // What the taps pour carries their substances (the dryers' air none).
+  if (!scene_.substances.empty()) {
+    std::vector<std::vector<double>> concentrations;
+    for (const Emitter& e : scene_.emitters) concentrations.push_back(e.substances);
+    add_substance_columns(out, scene_, first_of, concentrations);
   }
   return out;
 }

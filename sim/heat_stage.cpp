@@ -10,6 +10,7 @@
 #include "sim/kernels/dryer_model.h"
 #include "sim/kernels/heat_params.h"
 #include "sim/solver.h"
+#include "sim/substance_stage.h"
 
 namespace thaw {
 
@@ -32,6 +33,7 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
 
   std::string opts = build_options;
   if (uses_surface()) opts += " -DTHAW_SURFACE_AREA";
+  if (substances_lower_melting(scene)) opts += " -DTHAW_MELT_SHIFT";
   if (plan.ambient) opts += " -DTHAW_AMBIENT";
   if (plan.dryers) opts += " -DTHAW_DRYERS";
   if (plan.walls) opts += " -DTHAW_WALL_HEAT";
@@ -204,8 +206,10 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
     P.face_fraction = static_cast<float>(-std::expm1(-double(P.dt_heat) / air.face_time));
     P.face_enthalpy = static_cast<float>(enthalpy_at(scene_, air.material, scene_.heat.ambient_temperature));
   }
+  // Without a melt shift the kernels never touch its argument; any buffer fills it.
+  const cl::Buffer& shift = has_melt_shift_ ? store_[melt_shift_] : dryers_;
   set_args(k_thermal_state_, store_[core_.position], store_[core_.density], store_[enthalpy_],
-           store_[core_.phase], store_[core_.material], materials_, thermal_, P);
+           store_[core_.phase], store_[core_.material], materials_, thermal_, P, shift);
   launch(q, k_thermal_state_, layout_.n);
   if (plan_.adiabatic) {
     set_args(k_adiabatic_, store_[core_.position], store_[core_.phase], store_[core_.material], materials_,
@@ -217,7 +221,8 @@ bool HeatStage::run(double dt, const NeighbourView& nv, EnergyBudget& budget, st
   const cl::Buffer& lamp_energy = plan_.lamps ? lamp_energy_ : dryers_;
   set_args(k_heat_, store_[core_.position], store_[core_.velocity], store_[enthalpy_], store_[core_.phase],
            store_[core_.material], materials_, nv.soa, thermal_, nv.cell_start, nv.grid, P, dryers_,
-           lamp_energy, budget_parts_, phase_changed_, uses_surface() ? store_[surface_area_] : dryers_);
+           lamp_energy, budget_parts_, phase_changed_, uses_surface() ? store_[surface_area_] : dryers_,
+           shift);
   launch(q, k_heat_, layout_.n);
   set_args(k_budget_, budget_parts_, store_[enthalpy_], layout_.stride, budget_tiles_, budget_bad_, n,
            layout_.tile);

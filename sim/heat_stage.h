@@ -41,6 +41,13 @@ class HeatStage {
   bool uses_surface() const;
   void surface_from(ParticleStore::Field area) { surface_area_ = area; }
 
+  // Where substances lower the melting point (substances_lower_melting in sim/substance_stage.h), the
+  // substance stage's "melt_shift" field [K], handed here by the solver before the first run.
+  void melt_shift_from(ParticleStore::Field shift) {
+    melt_shift_ = shift;
+    has_melt_shift_ = true;
+  }
+
   // The stage's limit on dt [s]: diffusion, the tank walls, exchange with the air and the dryers.
   double max_dt() const;
 
@@ -78,6 +85,8 @@ class HeatStage {
   float support_ = 0, smoothing_ = 0, rest_density_ = 0;
   const ParticleLayout& layout_;  // the solver's: the particle count changes when water leaves
   ParticleStore::Field enthalpy_ = 0, surface_area_ = 0;
+  ParticleStore::Field melt_shift_ = 0;
+  bool has_melt_shift_ = false;
   cl::Kernel k_thermal_state_, k_heat_, k_absorb_, k_budget_, k_adiabatic_;
   cl::Buffer materials_, thermal_, lamp_energy_, hits_, budget_parts_, budget_tiles_, budget_bad_, dryers_,
       phase_changed_;

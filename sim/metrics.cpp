@@ -29,6 +29,7 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
   m.max_temperature = m.air_max_temperature = -std::numeric_limits<double>::infinity();
   double air_sum = 0;
   std::size_t air_count = 0;
+  const std::vector<double> shift = m.heat ? melt_shifts_of(p, scene) : std::vector<double>{};
   for (std::size_t i = 0; i < p.size(); ++i) {
     const auto phase = static_cast<Phase>(p.phase[i]);
     ++m.count[static_cast<int>(phase)];
@@ -40,7 +41,7 @@ Metrics measure(const HostParticles& p, const Scene& scene, double rest_density)
       m.enthalpy_scale += mass * std::abs(h);
       if (phase == Phase::Water || phase == Phase::Ice) {
         (phase == Phase::Ice ? m.ice_mass : m.water_mass) += mass;
-        const double T = temperature_at(mt, h);
+        const double T = temperature_at(mt, h, shift.empty() ? 0.0 : shift[i]);
         m.min_temperature = std::min(m.min_temperature, T);
         m.max_temperature = std::max(m.max_temperature, T);
         t_sum += T;
@@ -90,7 +91,24 @@ Metrics measure(const Solver& s) {
   m.inflow = s.inflow();
   m.bodies = bodies_json(s);
   m.pressure_solve = pressure_solve_json(s);
+  m.substances = substances_json(s);
   return m;
+}
+
+Json substances_json(const Solver& s) {
+  const std::vector<Substance>& list = s.scene().substances;
+  if (list.empty()) return nullptr;
+  const std::vector<double> total = s.substance_totals();
+  const SubstanceBooks& books = s.substance_books();
+  Json out = Json::object();
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const double closure = books.closure(k, total[k]), scale = books.initial[k] + books.inflow[k];
+    out[list[k].name] = {
+        {"total", total[k]},           {"initial", books.initial[k]},
+        {"outflow", books.outflow[k]}, {"inflow", books.inflow[k]},
+        {"closure", closure},          {"closure_relative", scale > 0 ? closure / scale : 0.0}};
+  }
+  return out;
 }
 
 Json pressure_solve_json(const Solver& s) {
@@ -149,6 +167,7 @@ Json metrics_json(const Metrics& m, double wall_ms_per_step, const Json& stage_m
   j["energy"] = {{"kinetic", m.kinetic}, {"potential", m.potential}, {"mechanical", m.kinetic + m.potential}};
   if (!m.bodies.is_null()) j["bodies"] = m.bodies;
   if (!m.pressure_solve.is_null()) j["dfsph"] = m.pressure_solve;
+  if (!m.substances.is_null()) j["substances"] = m.substances;
   if (m.outflow.particles)
     j["outflow"] = {{"particles", m.outflow.particles},
                     {"mass", m.outflow.mass},

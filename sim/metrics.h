@@ -35,7 +35,14 @@ struct Metrics {
   Json bodies;
   // DFSPH (solver.pressure dfsph): the last step's solves and the run's counts; null otherwise.
   Json pressure_solve;
+  // Substances (scenes that declare them): by name, the total now, at the start, what left through open
+  // sides and what emitters poured [kg], and the closure total + outflow - initial - inflow (absolute, and
+  // relative to initial + inflow); null otherwise.
+  Json substances;
 };
+
+// What a solver reports of its substances, as Metrics::substances (null without substances).
+Json substances_json(const Solver& solver);
 
 // What a DFSPH solver reports of its solves (null for WCSPH).
 Json pressure_solve_json(const Solver& solver);

@@ -14,6 +14,7 @@
 #include "sim/error.h"
 #include "sim/little_endian.h"
 #include "sim/state_file.h"
+#include "sim/substance_stage.h"
 
 namespace thaw {
 namespace {
@@ -91,6 +92,19 @@ std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::
     t.bytes.reserve(4 * n);
     for (std::size_t i : order) put_little_endian(t.bytes, temperature[i]);
     arrays.push_back(std::move(t));
+  }
+  // Substances (sim/substance_stage.h): each one's mass fraction, the amount over the particle's mass.
+  for (const HostColumn& c : p.columns) {
+    if (c.spec.name.rfind(kSubstancePrefix, 0) != 0 || c.spec.width != 2 || c.size() != p.size()) continue;
+    VtkArray a{c.spec.name, "Float32", 1, {}};
+    a.bytes.reserve(4 * n);
+    const Float2* q = c.as<Float2>();
+    for (std::size_t i : order) {
+      const float m = p.position[i][3];
+      put_little_endian(a.bytes,
+                        m > 0.0f ? static_cast<float>((double(q[i][0]) + double(q[i][1])) / m) : 0.0f);
+    }
+    arrays.push_back(std::move(a));
   }
   // Every field a stage declared as exported (sim/particle_fields.h), element by element in id order.
   for (const HostColumn& c : p.columns) {

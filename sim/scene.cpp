@@ -283,6 +283,7 @@ Material material_from_json(const std::string& name, const Json& m) {
   mat.specific_heat = m["specific_heat"].get<double>();
   mat.transparent = m.contains("transparent") && m["transparent"].get<bool>();  // solids only
   mat.adiabatic = m.contains("adiabatic") && m["adiabatic"].get<bool>();        // solids only
+  if (m.contains("cryoscopic_constant")) mat.cryoscopic_constant = m["cryoscopic_constant"].get<double>();
   return mat;
 }
 
@@ -319,15 +320,41 @@ double temperature_or(const Json& object, double fallback) {
 }
 
 // Phase-changing materials start on their own side of the melting point (no supercooled water here).
-void check_start(const Scene& s, int material, double T, const std::string& path) {
+// A fluid holding `concentrations` of the scene's substances freezes that much lower (the melting point
+// drop the substance stage gives it, docs/SUBSTANCES.md).
+void check_start(const Scene& s, int material, double T, const std::string& path,
+                 const std::vector<double>& concentrations = {}) {
   const Material& m = s.materials[static_cast<std::size_t>(material)];
   if (m.partner < 0) return;
   if (m.kind == MaterialKind::Ice && T > m.melting_point)
     throw SceneError(path, format_number(T) + " °C is above the melting point of '" + m.name + "' (" +
                                format_number(m.melting_point) + " °C)");
-  if (m.kind == MaterialKind::Fluid && T < m.melting_point)
+  const double drop = melting_point_drop(s, material, concentrations);
+  if (m.kind == MaterialKind::Fluid && T < m.melting_point - drop)
     throw SceneError(path, format_number(T) + " °C is below the freezing point of '" + m.name + "' (" +
-                               format_number(m.melting_point) + " °C); supercooled fluid is not modelled");
+                               format_number(m.melting_point - drop) + " °C" +
+                               (drop > 0 ? " with what is dissolved in it" : "") +
+                               "); supercooled fluid is not modelled");
+}
+
+// The concentration of each of the scene's substances [kg/m^3] that a fluid block or an emitter (`entry`, at
+// `path`) gives in its `substances`; 0 for those it does not name.
+std::vector<double> concentrations_from_json(const Json& entry, const std::string& path, const Scene& s) {
+  std::vector<double> out(s.substances.size(), 0.0);
+  if (!entry.contains("substances")) return out;
+  for (const auto& [name, value] : entry["substances"].items()) {
+    const auto it = std::find_if(s.substances.begin(), s.substances.end(),
+                                 [&](const Substance& d) { return d.name == name; });
+    if (it == s.substances.end()) {
+      std::string known;
+      for (const Substance& d : s.substances) known += (known.empty() ? "" : ", ") + d.name;
+      throw SceneError(path + ".substances." + name,
+                       "the scene's `substances` declare no substance of this name (" +
+                           (known.empty() ? "it declares none" : "it declares " + known) + ")");
+    }
+    out[static_cast<std::size_t>(it - s.substances.begin())] = value["concentration"].get<double>();
+  }
+  return out;
 }
 
 // `materials` is the document's block, for the names; `s` has the domain, the materials and the ambient
@@ -341,7 +368,9 @@ FluidBlock fluid_block_from_json(Json& f, const std::string& path, const Scene& 
   block.velocity = vec(f["velocity"]);
   block.temperature = temperature_or(f, s.heat.ambient_temperature);
   check_inside(s.domain, block.box, block.shape.axis_aligned_box() ? path + ".box" : path);
-  check_start(s, block.material, block.temperature, path + (f.contains("temperature") ? ".temperature" : ""));
+  block.substances = concentrations_from_json(f, path, s);
+  check_start(s, block.material, block.temperature, path + (f.contains("temperature") ? ".temperature" : ""),
+              block.substances);
   return block;
 }
 
@@ -469,6 +498,19 @@ Scene convert_and_check(Json doc, const std::string& folder) {
   }
   s.heat = heat_settings_from_json(doc);
   s.tension = tension_settings_from_json(doc["tension"]);
+  for (const auto& [name, d] : doc["substances"].items()) {
+    if (s.substances.size() == std::size_t(kMaxSubstances))
+      throw SceneError("substances",
+                       "a scene carries at most " + std::to_string(kMaxSubstances) +
+                           " substances (their stage walks the neighbours once for all of them)");
+    Substance sub;
+    sub.name = name;
+    sub.diffusivity = d["diffusivity"].get<double>();
+    sub.molar_mass = d["molar_mass"].get<double>();
+    sub.dissociation = d["dissociation"].get<double>();
+    sub.enters_ice = d["enters_ice"].get<bool>();
+    s.substances.push_back(sub);
+  }
   s.camera = camera_from_json(doc["camera"]);
 
   s.walls = domain["walls"].get<std::vector<std::string>>();
@@ -566,6 +608,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     if (!e.contains("temperature")) e["temperature"] = s.heat.ambient_temperature;
     const std::string path = join_path("emitters", i);
     s.emitters.push_back(emitter_from_json(e, path, s.materials));
+    s.emitters.back().substances = concentrations_from_json(e, path, s);
     check_emitter(s.emitters.back(), s, path);
   }
 
@@ -1065,6 +1108,21 @@ Scene load_scene(const std::string& file, const std::vector<std::string>& overri
   Json doc = read_json_file(path);
   if (doc.is_object() && !doc.contains("name")) doc["name"] = std::filesystem::path(path).stem().string();
   return scene_from_json(std::move(doc), overrides, std::filesystem::path(path).parent_path().string());
+}
+
+double melting_point_drop(const Scene& s, int material, const std::vector<double>& concentrations) {
+  const Material& m = s.materials[static_cast<std::size_t>(material)];
+  if (m.kind != MaterialKind::Fluid) return 0.0;
+  double dissolved = 0.0, particles = 0.0;  // per kg of solution: kg of substance, mol of particles
+  for (std::size_t k = 0; k < concentrations.size() && k < s.substances.size(); ++k) {
+    const Substance& sub = s.substances[k];
+    const double fraction = concentrations[k] / m.density;
+    dissolved += fraction;
+    if (sub.lowers_melting_point()) particles += sub.dissociation * fraction / sub.molar_mass;
+  }
+  return dissolved < 1.0
+             ? std::min(m.cryoscopic_constant * particles / (1.0 - dissolved), kMaxMeltingPointDrop)
+             : kMaxMeltingPointDrop;
 }
 
 }  // namespace thaw

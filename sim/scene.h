@@ -70,6 +70,8 @@ struct Material {
   double specific_heat = 0.0;  // c [J/kg/K]
   double latent_heat = 0.0;    // L [J/kg] of an ice and the fluid it melts into; 0 otherwise
   double melting_point = 0.0;  // T_m [°C] of the same pair
+  double cryoscopic_constant =
+      1.86;                    // K_f [K kg/mol] of a fluid: its melting point falls K_f i b (substances)
   int partner = -1;            // ice: the fluid it melts into; fluid: the ice it freezes into; -1 none
   bool transparent = false;    // solids: drawn as glass (the renderer's business only)
   bool adiabatic = false;      // solids: an ideal insulator (heat.cl, adiabatic_state)
@@ -114,12 +116,29 @@ struct AirFill {
   double max_temperature = 100.0;    // T_max [°C]
 };
 
+// A substance the water carries (issue 20; docs/SUBSTANCES.md): dissolved in the bulk of the water, moved
+// with its particles and by Fick's diffusion between them (Cleary & Monaghan 1999's pairwise form, as
+// Orthmann et al. 2013 sec. 5 carry their bulk quantities). Each particle holds its amount [kg].
+struct Substance {
+  std::string name;
+  double diffusivity = 1e-9;  // D in water [m^2/s]
+  // Lowering the melting point (Blagden's law with van 't Hoff's factor): each mole of it per kg of water
+  // lowers the water's melting point by the fluid's cryoscopic constant times `dissociation`. molar_mass 0:
+  // it does not (a dye).
+  double molar_mass = 0.0;    // M [kg/mol]
+  double dissociation = 1.0;  // van 't Hoff's factor i: ions per formula unit (NaCl 2)
+  bool enters_ice = false;    // false: water that freezes gives it up to the water around it
+  bool lowers_melting_point() const { return molar_mass > 0; }
+};
+inline constexpr int kMaxSubstances = 4;  // per scene: the stage walks the neighbours once for all of them
+
 struct FluidBlock {
   int material = 0;  // index into Scene::materials
   Shape shape;       // filled with particles on a lattice of the scene's spacing (a box unless it says)
   Box box;           // the shape's bounding box
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   double temperature = 20.0;  // initial [°C]
+  std::vector<double> substances;  // initial concentration of each of Scene::substances [kg/m^3]
 };
 
 struct IceBlock {
@@ -178,6 +197,7 @@ struct Emitter {
   double radius = 0.005;                                  // of the nozzle [m]
   double speed = 0.5;                                     // exit speed [m/s]
   double temperature = 20.0;                              // of the fluid poured [°C]
+  std::vector<double> substances;  // each of Scene::substances in what it pours [kg/m^3]; fixed while it runs
   double start = 0.0;                                     // pours from this time on [s]
   double stop = 0.0;                                      // and until this time [s]; 0: for ever
   // The nozzle's area pi r^2 [m^2] and the volume flow A v [m^3/s] it pours while open.
@@ -289,9 +309,18 @@ struct Scene {
   std::vector<Lamp> lamps;
   std::vector<Dryer> dryers;
   std::vector<Emitter> emitters;
+  std::vector<Substance> substances;  // in the document's order; at most kMaxSubstances
   SceneCamera camera;
   Json source;  // the validated document with every default filled in
 };
+
+// How far below its material's melting point a fluid holding `concentrations` of the scene's substances
+// [kg/m^3] melts [K]: Blagden's law with van 't Hoff's factor, K_f sum_s i_s b_s over the substances with a
+// molar mass (b_s their molality), capped at kMaxMeltingPointDrop; 0 for other materials. The substance
+// stage computes the same per particle (sim/kernels/substance.cl).
+inline constexpr double kMaxMeltingPointDrop =
+    40.0;  // [K]: past NaCl's eutectic the dilute law means nothing
+double melting_point_drop(const Scene& s, int material, const std::vector<double>& concentrations);
 
 // A number as messages show it: the shortest form ("0.004", "1100", "1e-09").
 std::string format_number(double v);

@@ -190,7 +190,9 @@ HostParticles sample_scene(const Scene& scene) {
     for (const Vec3& x : points) add(p, x, Vec3::Zero(), boundary_mass, Phase::Ice, c.material, h, anchored);
   }
   // Fluid blocks, skipping lattice points inside solids, ice or an earlier block.
+  std::vector<std::size_t> first_of;  // each block's first particle, then one past the last block's
   for (std::size_t b = 0; b < scene.fluids.size(); ++b) {
+    first_of.push_back(p.size());
     const auto& f = scene.fluids[b];
     const float mass = static_cast<float>(scene.materials[f.material].density * dx * dx * dx);
     const double h = enthalpy_at(scene, f.material, f.temperature);
@@ -201,6 +203,7 @@ HostParticles sample_scene(const Scene& scene) {
     for (std::size_t e = 0; e < b; ++e) drop_inside(points, scene.fluids[e].shape);
     for (const Vec3& x : points) add(p, x, f.velocity, mass, Phase::Water, f.material, h);
   }
+  first_of.push_back(p.size());
   // Air: the domain's lattice over its region, skipping points inside solids, ice or fluid blocks.
   if (scene.has_air()) {
     const AirFill& a = scene.air;
@@ -214,6 +217,11 @@ HostParticles sample_scene(const Scene& scene) {
     for (const Vec3& x : points) add(p, x, Vec3::Zero(), mass, Phase::Air, a.material, h);
   }
   if (p.size() > std::size_t(0xffffffffu)) throw SceneError("spacing", "too many particles for 32-bit ids");
+  if (!scene.substances.empty()) {
+    std::vector<std::vector<double>> concentrations;
+    for (const FluidBlock& f : scene.fluids) concentrations.push_back(f.substances);
+    add_substance_columns(p, scene, first_of, concentrations);
+  }
   return p;
 }
 

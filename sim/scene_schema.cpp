@@ -209,6 +209,20 @@ std::vector<Field> shape_fields(const std::string& box_doc) {
   };
 }
 
+// A fluid block's or an emitter's `substances`: each substance's concentration, by the name the scene's
+// `substances` gives it (docs/SUBSTANCES.md).
+Field dissolved_substances(const std::string& doc) {
+  return map_of("substances", "<substance>",
+                {
+                    number("concentration", "Mass of substance per volume of fluid; 1 kg/m^3 is 1 g/L")
+                        .in("kg/m^3")
+                        .at_least(0)
+                        .at_most(1e4),
+                },
+                doc + ", by the name the scene's `substances` gives them")
+      .def(Json::object());
+}
+
 // An ice or solid entry: its shape, its material, the shape's fields, then `rest`.
 std::vector<Field> shaped_entry(Field shape, Field material, const std::string& box_doc,
                                 std::vector<Field> rest) {
@@ -417,6 +431,39 @@ const Field& scene_schema() {
                       .client_settable(),
               },
               "Still air around the scene (the mode without air particles)."),
+          map_of("substances", "<name>",
+                 {
+                     number("diffusivity",
+                            "Its molecular diffusivity D in water: about 1e-9 for a dye or a salt at 20 °C "
+                            "(NaCl 1.5e-9), 0 for none")
+                         .in("m^2/s")
+                         .def(1e-9)
+                         .at_least(0)
+                         .at_most(1e-2),
+                     number("molar_mass",
+                            "Its molar mass, which makes it lower the melting point of the water it is "
+                            "dissolved in by the fluid's cryoscopic_constant times dissociation times its "
+                            "molality (Blagden's law with van 't Hoff's factor): NaCl 0.05844. 0: it does "
+                            "not (a dye)")
+                         .in("kg/mol")
+                         .def(0.0)
+                         .at_least(0)
+                         .at_most(100),
+                     number("dissociation",
+                            "van 't Hoff's factor i: the particles one formula unit makes in solution (NaCl "
+                            "2, sugar 1)")
+                         .def(1.0)
+                         .at_least(1)
+                         .at_most(10),
+                     flag("enters_ice",
+                          "Whether water that freezes keeps it; false (salt, dye): the freezing water gives "
+                          "it up to the water around it")
+                         .def(false),
+                 },
+                 "Substances the water carries (docs/SUBSTANCES.md), at most 4: each water particle holds "
+                 "its amount of each, which moves with it and diffuses to the water around it; fluids' "
+                 "`substances` say where they start")
+              .def(Json::object()),
           map_of("materials", "<name>",
                  {
                      choice("kind", {"fluid", "solid", "ice", "air"},
@@ -447,6 +494,14 @@ const Field& scene_schema() {
                           "it runs short of neighbours within a kernel's reach (solids)")
                          .def(false)
                          .when("kind", "solid"),
+                     number("cryoscopic_constant",
+                            "K_f of a fluid: how far a mole of dissolved particles per kg lowers its melting "
+                            "point (substances with a molar_mass); water 1.86")
+                         .in("K kg/mol")
+                         .def(1.86)
+                         .at_least(0)
+                         .at_most(100)
+                         .when("kind", "fluid"),
                      text("melts_into", "The fluid material this ice becomes; it freezes back into this ice")
                          .when("kind", "ice"),
                      number("latent_heat", "Latent heat of fusion L")
@@ -479,6 +534,7 @@ const Field& scene_schema() {
                                .above(-273.15)
                                .at_most(3000)
                                .optional(),
+                           dissolved_substances("Substances dissolved in this fluid at the start"),
                        }),
                    "Bodies of fluid particles (lattice points inside solids, ice or earlier fluid are left "
                    "out).")
@@ -713,6 +769,8 @@ const Field& scene_schema() {
                       .at_most(3000)
                       .optional()
                       .live_in_place(),
+                  dissolved_substances(
+                      "Substances dissolved in the fluid poured (fixed while the scene runs)"),
                   number("start", "Pours from this time on").in("s").def(0.0).at_least(0).live_in_place(),
                   number("stop", "Stops pouring at this time; 0: never")
                       .in("s")

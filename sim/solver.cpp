@@ -186,6 +186,25 @@ OutflowBooks OutflowBooks::from_vector(const std::vector<double>& v) {
   return b;
 }
 
+std::vector<double> SubstanceBooks::to_vector() const {
+  std::vector<double> v = initial;
+  v.insert(v.end(), outflow.begin(), outflow.end());
+  v.insert(v.end(), inflow.begin(), inflow.end());
+  return v;
+}
+
+SubstanceBooks SubstanceBooks::from_vector(const std::vector<double>& v, std::size_t count) {
+  if (v.size() != 3 * count)
+    throw Error("state: the substances' account has " + std::to_string(v.size()) + " entries; the scene's " +
+                std::to_string(count) + " substances need " + std::to_string(3 * count));
+  SubstanceBooks b;
+  const auto at = [&](std::size_t k) { return v.begin() + static_cast<std::ptrdiff_t>(k * count); };
+  b.initial.assign(at(0), at(1));
+  b.outflow.assign(at(1), at(2));
+  b.inflow.assign(at(2), at(3));
+  return b;
+}
+
 EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
   if (v.size() < 8 || v.size() > 10)
     throw Error("energy budget has " + std::to_string(v.size()) +
@@ -327,6 +346,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
 
   // The stages this scene needs, each declaring its fields; then the fields are allocated and filled.
   rigid_.reset();
+  substances_.reset();
   tension_.reset();
   surface_.reset();
   surface_done_ = false;
@@ -359,6 +379,13 @@ void Solver::build(const SimState& st, std::size_t capacity) {
     surface_ = std::make_unique<SurfaceStage>(cl_, store_, f_, scene_, k_, opts, layout_);
     heat_->surface_from(surface_->area());
   }
+  if (!scene_.substances.empty()) {
+    const ParticleStore::Field enthalpy = heat_ ? heat_->enthalpy() : 0;
+    substances_ = std::make_unique<SubstanceStage>(cl_, store_, f_, scene_, k_, opts, layout_,
+                                                   heat_ ? &enthalpy : nullptr);
+  }
+  if (heat_ && substances_ && substances_lower_melting(scene_))
+    heat_->melt_shift_from(substances_->melt_shift());
   if (fluid_ && heat_) fluid_->buoyancy_from(heat_->enthalpy());
   if (dfsph_ && heat_) dfsph_->rest_density_from(heat_->enthalpy());
   store_.allocate(layout_.capacity);
@@ -382,6 +409,13 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   budget_ = st.energy_budget.empty() ? EnergyBudget{} : EnergyBudget::from_vector(st.energy_budget);
   outflow_ = OutflowBooks::from_vector(st.outflow);
   if (st.energy_budget.empty()) budget_.initial = total_enthalpy();
+  if (substances_ && !st.substances.empty()) {
+    substance_books_ = SubstanceBooks::from_vector(st.substances, scene_.substances.size());
+  } else if (substances_) {
+    substance_books_.initial = substances_->totals();
+    substance_books_.outflow.assign(scene_.substances.size(), 0.0);
+    substance_books_.inflow.assign(scene_.substances.size(), 0.0);
+  }
 }
 
 Solver::~Solver() = default;
@@ -443,6 +477,15 @@ void Solver::remove_particles_from(std::size_t kept) {
   q.enqueueReadBuffer(store_[f_.material], CL_FALSE, kept, gone, material.data());
   if (heat_) q.enqueueReadBuffer(store_[heat_->enthalpy()], CL_FALSE, kept * 8, gone * 8, h.data());
   q.enqueueReadBuffer(store_[f_.id], CL_TRUE, kept * 4, gone * 4, id.data());
+  // Substances that left with the water, booked before the particles go.
+  if (substances_) {
+    std::vector<Float2> amount(gone);
+    for (std::size_t s = 0; s < substances_->fields().size(); ++s) {
+      q.enqueueReadBuffer(store_[substances_->fields()[s]], CL_TRUE, kept * sizeof(Float2),
+                          gone * sizeof(Float2), amount.data());
+      for (const Float2& a : amount) substance_books_.outflow[s] += double(a[0]) + double(a[1]);
+    }
+  }
   for (std::size_t k = 0; k < gone; ++k) {
     if (!heat_) h[k] = fixed_enthalpy_[id[k]];
     const double mass = double(x[k][3]) * table_[material[k]].thermal_mass_scale;
@@ -466,6 +509,7 @@ void Solver::emit(double dt) {
     const NeighbourGrid::EmptySites empty =
         grid_->empty_sites(store_, f_, EmitterStage::room_air_gap * scene_.spacing);
     emitters_->admit_room_air(empty.site, empty.velocity, in, next_id_);
+    in.resize(in.size());  // the room's air carries no substance: its columns' rows are zeros
   }
   if (in.size() == 0) return;
   if (n_ + in.size() > layout_.capacity) {
@@ -490,6 +534,10 @@ void Solver::emit(double dt) {
     const double mass = double(in.position[i][3]) * table_[in.material[i]].thermal_mass_scale;
     budget_.inflow += mass * (double(in.enthalpy[i][0]) + double(in.enthalpy[i][1]));
   }
+  for (std::size_t s = 0; substances_ && s < scene_.substances.size(); ++s)
+    if (const HostColumn* c = in.column(substance_field(scene_.substances[s].name).name))
+      for (std::size_t i = 0; i < in.size(); ++i)
+        substance_books_.inflow[s] += double(c->as<Float2>()[i][0]) + double(c->as<Float2>()[i][1]);
   if (!heat_) {
     fixed_enthalpy_.resize(next_id_, Float2{0.f, 0.f});
     for (std::size_t i = 0; i < in.size(); ++i) fixed_enthalpy_[in.id[i]] = in.enthalpy[i];
@@ -533,8 +581,10 @@ double Solver::heat_time_step() const {
 double Solver::choose_time_step() {
   const auto& s = scene_.solver;
   if (!s.flow) {
-    // Nothing moves: only heat limits the step.
-    double dt = static_cast<float>(std::min(s.max_dt, heat_time_step()));
+    // Nothing moves: only heat and the substances' diffusion limit the step.
+    double dt = std::min(s.max_dt, heat_time_step());
+    if (substances_) dt = std::min(dt, substances_->max_dt());
+    dt = static_cast<float>(dt);
     if (dt < s.min_dt) {
       std::ostringstream os;
       os << "step " << steps_ + 1 << " (t = " << time_ << " s): the heat time step " << dt
@@ -601,6 +651,7 @@ double Solver::choose_time_step() {
   const double hv = std::min(double(h), scene_.spacing);
   if (k_.kinematic_viscosity > 0) dt = std::min(dt, s.viscous_number * hv * hv / k_.kinematic_viscosity);
   if (tension_) dt = std::min(dt, k_.capillary_dt);
+  if (substances_) dt = std::min(dt, substances_->max_dt());
   // Conduction's limit, or as many of it as heat.max_substeps lets one flow step hold (compute_heat).
   const double dt_heat = heat_time_step() * scene_.heat.max_substeps;
   dt = std::min(dt, dt_heat);
@@ -681,7 +732,9 @@ void Solver::step() {
   if (rigid_) timed(Stage::IceForces, [&] { rigid_->compute_forces(buffers()); });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
+  if (substances_) timed(Stage::Substances, [&] { substances_->prepare(neighbours()); });
   if (heat_) heat_stages(dt);
+  if (substances_) timed(Stage::Substances, [&] { substances_->diffuse(dt, neighbours()); });
   if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
   if (flow)
     timed(Stage::Integrate, [&] {
@@ -713,7 +766,9 @@ void Solver::step_dfsph() {
   if (tension_) timed(Stage::Tension, [&] { tension_->run(neighbours(), fluid_->accel()); });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
+  if (substances_) timed(Stage::Substances, [&] { substances_->prepare(neighbours()); });
   if (heat_) heat_stages(dt);
+  if (substances_) timed(Stage::Substances, [&] { substances_->diffuse(dt, neighbours()); });
   timed(Stage::Pressure, [&] {
     dfsph_->predict(fluid_->accel(), neighbours(), dt, 1.0 / (1.0 + damping_ * dt));
     dfsph_->density_solve(neighbours(), dt);
@@ -759,6 +814,7 @@ void Solver::warm_up() {
     surface_->run(neighbours());
     surface_done_ = true;
   }
+  if (substances_) substances_->prepare(neighbours());  // (diffusing waits for a step)
   if (heat_) heat_->warm_up(neighbours(), budget_);
   cl_.queue().finish();
 }
@@ -796,7 +852,8 @@ bool Solver::set_emitter(std::size_t index, const Emitter& e) {
   const std::string path = "emitters[" + std::to_string(index) + "]";
   Json j = to_json(e, scene_.materials);
   validate(j, *find_field(scene_schema(), "emitters[0]"), path);
-  const Emitter checked = emitter_from_json(j, path, scene_.materials);
+  Emitter checked = emitter_from_json(j, path, scene_.materials);
+  checked.substances = scene_.emitters[index].substances;  // fixed while the scene runs
   check_emitter(checked, scene_, path);
   if (checked.material != scene_.emitters[index].material) return false;
   if (!heat_ && checked.temperature != scene_.emitters[index].temperature) return false;
@@ -826,6 +883,7 @@ std::vector<std::string> Solver::stages() const {
     out.push_back("photons (when a lamp is on)");
   if (surface_) out.push_back(std::string("surface (") + name(scene_.heat.exposed_area) + ")");
   if (heat_) out.push_back("heat (" + heat_reason_ + ")");
+  if (substances_) out.push_back("substances (" + std::to_string(scene_.substances.size()) + ")");
   if (fluid_) out.push_back("integrate");
   // A scene without taps or dryers has this stage for its open sides: say so.
   if (emitters_)
@@ -895,12 +953,22 @@ SimState Solver::state() const {
   s.energy_budget = budget_.to_vector();
   if (outflow_.particles) s.outflow = outflow_.to_vector();
   if (emitters_) s.inflow = emitters_->save({next_id_, layout_.capacity});
+  if (substances_) s.substances = substance_books_.to_vector();
   if (rigid_) {
     RigidIce::Saved r = rigid_->save();
     s.rigid_bodies = std::move(r.bodies);
     s.rigid_labelling = std::move(r.labelling);
   }
   return s;
+}
+
+std::vector<double> Solver::substance_totals() const {
+  return substances_ ? substances_->totals() : std::vector<double>{};
+}
+
+std::vector<float> Solver::melt_shifts() const {
+  return substances_ && heat_ && substances_lower_melting(scene_) ? substances_->melt_shifts()
+                                                                  : std::vector<float>{};
 }
 
 std::vector<std::uint32_t> Solver::cell_starts() const { return grid_->cell_starts(); }

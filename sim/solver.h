@@ -21,6 +21,7 @@
 #include "sim/scene.h"
 #include "sim/stage_timers.h"
 #include "sim/state_file.h"
+#include "sim/substance_stage.h"
 #include "sim/surface_stage.h"
 #include "sim/tension_stage.h"
 
@@ -80,6 +81,17 @@ struct OutflowBooks {
   static OutflowBooks from_vector(const std::vector<double>& v);  // empty: nothing has left
 };
 
+// Each substance's account [kg] (sim/substance_stage.h), in the scene's order: its total at the start, what
+// left through open sides since and what emitters poured. Closure: the total now + outflow = initial +
+// inflow, to round-off.
+struct SubstanceBooks {
+  std::vector<double> initial, outflow, inflow;
+  double closure(std::size_t s, double total) const { return total + outflow[s] - initial[s] - inflow[s]; }
+  std::vector<double> to_vector() const;  // initial, outflow, inflow
+  // Throws Error unless `v` holds three entries per substance (3 * count).
+  static SubstanceBooks from_vector(const std::vector<double>& v, std::size_t count);
+};
+
 class PhotonTracer;
 class RigidIce;
 struct ParticleBuffers;
@@ -125,6 +137,13 @@ class Solver {
   const OutflowBooks& outflow() const { return outflow_; }
   // What came in through emitters (zero without them).
   InflowBooks inflow() const { return emitters_ ? emitters_->books() : InflowBooks{}; }
+  // Substances (empty in scenes without them): each one's total over all particles now [kg], summed in
+  // double, and its account.
+  std::vector<double> substance_totals() const;
+  const SubstanceBooks& substance_books() const { return substance_books_; }
+  // How far below its material's melting point each particle melts [K], as the last step's substance stage
+  // left it (sim/substance_stage.h); empty unless substances lower the melting point.
+  std::vector<float> melt_shifts() const;
   // Particles the buffers hold room for: size() plus the spare that emitters fill (sim/stage.h).
   std::size_t capacity() const { return layout_.capacity; }
 
@@ -240,6 +259,8 @@ class Solver {
   std::unique_ptr<HeatStage> heat_;
   std::unique_ptr<SurfaceStage> surface_;  // only when heat_ takes its exposed areas from it
   std::unique_ptr<TensionStage> tension_;  // only with flow and tension.model other than none
+  std::unique_ptr<SubstanceStage> substances_;  // only where the scene declares substances
+  SubstanceBooks substance_books_;
   bool surface_done_ = false;  // the areas are there: computed in this run, or brought by its state
   std::string heat_reason_;
   std::vector<Float2> fixed_enthalpy_;

@@ -12,7 +12,8 @@ namespace thaw {
 // with emitters (sim/emitters.h), and includes growing the capacity. Pressure runs only with DFSPH
 // (sim/dfsph_stage.h): alpha, the divergence and density solves, and the predicted velocities. Surface runs
 // only where the heat stage takes its exposed areas from it (sim/surface_stage.h); Tension only with
-// tension.model (sim/tension_stage.h), after Forces.
+// tension.model (sim/tension_stage.h), after Forces; Substances only where the scene declares substances
+// (sim/substance_stage.h), after Heat.
 enum class Stage {
   Grid,
   Density,
@@ -24,14 +25,15 @@ enum class Stage {
   Photons,
   Surface,
   Heat,
+  Substances,
   Bodies,
   Integrate,
   Emit,
   Count
 };
 inline constexpr std::array<const char*, static_cast<int>(Stage::Count)> kStageNames = {
-    "grid",    "density", "forces", "tension", "pressure",  "ice_forces", "time_step",
-    "photons", "surface", "heat",   "bodies",  "integrate", "emit"};
+    "grid",    "density", "forces", "tension",    "pressure", "ice_forces", "time_step",
+    "photons", "surface", "heat",   "substances", "bodies",   "integrate",  "emit"};
 
 class StageTimers {
  public:

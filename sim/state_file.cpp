@@ -41,6 +41,7 @@ constexpr const char* kBodiesSection = "rigid_bodies";
 constexpr const char* kLabellingSection = "rigid_labelling";
 constexpr const char* kOutflowSection = "outflow";
 constexpr const char* kInflowSection = "inflow";
+constexpr const char* kSubstancesSection = "substances";
 constexpr std::size_t kPrefixBytes = 8 + 4 + 4;  // magic, version, byte order: the same in every version
 constexpr std::size_t kHeaderBytes = kPrefixBytes + 7 * 8 + 2 * 4 + 8;
 constexpr std::size_t kTrailerBytes = 8;
@@ -194,6 +195,7 @@ void for_each_global(State& s, Visit&& visit) {
   visit(kLabellingSection, s.rigid_labelling);
   visit(kOutflowSection, s.outflow);
   visit(kInflowSection, s.inflow);
+  visit(kSubstancesSection, s.substances);
 }
 
 // The arrays of one HostParticles must agree in length before they are written.
@@ -613,6 +615,7 @@ void check_state(const SimState& s, const Scene& scene, const std::string& origi
   all_finite(s.rigid_labelling, "rigid_labelling");
   all_finite(s.outflow, "outflow");
   all_finite(s.inflow, "inflow");
+  all_finite(s.substances, "substances");
 }
 
 }  // namespace thaw

@@ -28,7 +28,7 @@
 //                  free ice; files written before the type bits existed hold those two untyped).
 //                  Global: energy_budget (doubles), rigid_bodies and rigid_labelling (doubles, only in
 //                  runs with free ice), outflow (runs where water left through an open side), inflow
-//                  (runs with emitters).
+//                  (runs with emitters), substances (runs with substances).
 //   checksum       u64      FNV-1a-64 of every byte before it
 // Arrays are named sections so later versions can add per-particle fields (temperature, enthalpy,
 // body id) without breaking readers: a reader skips unknown optional sections and refuses unknown
@@ -66,6 +66,9 @@ struct SimState {
   // Emitters (EmitterStage::save, global section "inflow"): what came in, the next particle id, the
   // capacity and each emitter's pending length; empty in runs without emitters.
   std::vector<double> inflow;
+  // Substances (SubstanceBooks::to_vector, global section "substances"): each one's total at the start,
+  // then what left through open sides; empty in runs without substances.
+  std::vector<double> substances;
 };
 
 // Writes `state` to `path` atomically and durably; throws thaw::Error naming the path and the reason.

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "sim/emitters.h"
 #include "sim/solver.h"
+#include "sim/substance_stage.h"
 
 namespace thaw {
 
@@ -89,24 +91,73 @@ double enthalpy_at(const Scene& scene, int material, double temperature) {
                                    law.c_liquid);
 }
 
-double temperature_at(const MaterialThermal& m, double h) {
+double temperature_at(const MaterialThermal& m, double h, double shift) {
+  if (shift > 0 && m.latent > 0)
+    return thermal::thermal_temperature_lowered(h, m.latent, m.melt, m.c_solid, m.c_liquid, shift);
   return thermal::thermal_temperature(h, m.latent, m.melt, m.c_solid, m.c_liquid);
 }
 
-double liquid_fraction_at(const MaterialThermal& m, double h) {
+double liquid_fraction_at(const MaterialThermal& m, double h, double shift) {
+  if (shift > 0 && m.latent > 0)
+    return thermal::thermal_liquid_fraction_lowered(h, m.latent, m.c_solid, m.c_liquid, shift);
   return thermal::thermal_liquid_fraction(h, m.latent);
+}
+
+std::vector<double> melt_shifts_of(const HostParticles& p, const Scene& scene) {
+  std::vector<double> out;
+  if (!substances_lower_melting(scene)) return out;
+  out.assign(p.size(), 0.0);
+  if (const HostColumn* c = p.column(kMeltShiftField); c && c->size() == p.size()) {
+    for (std::size_t i = 0; i < p.size(); ++i) out[i] = double(c->as<float>()[i]);
+    return out;
+  }
+  // As substance.cl's substance_state: K_f sum_s i_s Q_s / M_s over the mass of the water, m - sum_s Q_s.
+  std::vector<const Float2*> amounts;
+  for (const Substance& s : scene.substances) {
+    const HostColumn* c = p.column(substance_field(s.name).name);
+    amounts.push_back(c && c->size() == p.size() ? c->as<Float2>() : nullptr);
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Material& m = scene.materials[p.material[i]];
+    if (p.phase[i] != std::uint8_t(Phase::Water) || m.kind != MaterialKind::Fluid) continue;
+    double dissolved = 0, particles = 0;
+    for (std::size_t k = 0; k < amounts.size(); ++k) {
+      if (!amounts[k]) continue;
+      const double q = double(amounts[k][i][0]) + double(amounts[k][i][1]);
+      dissolved += q;
+      const Substance& s = scene.substances[k];
+      if (s.lowers_melting_point()) particles += s.dissociation * q / s.molar_mass;
+    }
+    const double water = double(p.position[i][3]) - dissolved;
+    out[i] = water > 0 ? std::min(m.cryoscopic_constant * particles / water, kMaxMeltingPointDrop) : 0.0;
+  }
+  return out;
 }
 
 std::vector<float> temperatures_of(const HostParticles& p, const Scene& scene) {
   std::vector<float> out;
   if (!scene.heat.enabled || p.enthalpy.size() != p.size()) return out;
   const auto table = material_thermal_table(scene, derive_constants(scene).rest_density);
+  const std::vector<double> shift = melt_shifts_of(p, scene);
   out.reserve(p.size());
   for (std::size_t i = 0; i < p.size(); ++i)
-    out.push_back(static_cast<float>(
-        temperature_at(table[p.material[i]], double(p.enthalpy[i][0]) + double(p.enthalpy[i][1]))));
+    out.push_back(static_cast<float>(temperature_at(table[p.material[i]],
+                                                    double(p.enthalpy[i][0]) + double(p.enthalpy[i][1]),
+                                                    shift.empty() ? 0.0 : shift[i])));
   return out;
 }
+
+namespace {
+
+// The lowest melting point of the scene's ice materials [°C] (infinity without ice).
+double scene_min_melting_point(const Scene& scene) {
+  double t = std::numeric_limits<double>::infinity();
+  for (const Material& m : scene.materials)
+    if (m.kind == MaterialKind::Ice) t = std::min(t, m.melting_point);
+  return t;
+}
+
+}  // namespace
 
 HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
   HeatPlan plan;
@@ -156,6 +207,9 @@ HeatPlan plan_heat(const Scene& scene, const HostParticles& p) {
     why << "the scene has lamps";
   } else if (spread) {
     why << "temperatures range from " << *lo << " to " << *hi << " °C";
+  } else if (substances_lower_melting(scene) && !T.empty() && double(*lo) < scene_min_melting_point(scene)) {
+    // Brine below the ice's melting point melts it, and cools as it does.
+    why << "dissolved substances lower the melting point below the " << *lo << " °C the scene starts at";
   } else if (plan.ambient && differs(scene.heat.ambient_temperature)) {
     why << "the ambient air is at " << scene.heat.ambient_temperature << " °C";
   } else if (plan.air_faces && differs(scene.heat.ambient_temperature)) {

@@ -25,12 +25,20 @@ double mass_scale(const Material& m, double rest_density);
 // point is solid, everything else is on its liquid side).
 double enthalpy_at(const Scene& scene, int material, double temperature);
 
-// Temperature [°C] and liquid fraction from a particle's enthalpy (thermal_law.h, in double).
-double temperature_at(const MaterialThermal& m, double enthalpy);
-double liquid_fraction_at(const MaterialThermal& m, double enthalpy);
+// Temperature [°C] and liquid fraction from a particle's enthalpy (thermal_law.h, in double); `shift` [K]
+// lowers the melting point of a material that changes phase (dissolved substances: thermal_law.h's
+// thermal_temperature_lowered).
+double temperature_at(const MaterialThermal& m, double enthalpy, double shift = 0.0);
+double liquid_fraction_at(const MaterialThermal& m, double enthalpy, double shift = 0.0);
 
-// Temperatures [°C] of a particle set (e.g. read from a state file), one per particle; empty when the
-// scene has no heat or the particles carry no enthalpy.
+// How far below its material's melting point each particle melts [K] where the scene's substances lower it
+// (docs/SUBSTANCES.md): the substance stage's "melt_shift" column where the particles carry one (a running
+// solver's), else each water particle's from the substances it holds and 0 for ice (a state file, which does
+// not keep the shift: ice in brine then reads its own melting point). Empty where nothing lowers it.
+std::vector<double> melt_shifts_of(const HostParticles& p, const Scene& scene);
+
+// Temperatures [°C] of a particle set (e.g. read from a state file), one per particle, with their melt
+// shifts; empty when the scene has no heat or the particles carry no enthalpy.
 std::vector<float> temperatures_of(const HostParticles& p, const Scene& scene);
 
 // Thermal diffusivity k / (rho c) of the most diffusive material [m^2/s] that some particle has or can

@@ -13,9 +13,19 @@
 /* Per particle: temperature, conductivity and volume, in the structure-of-arrays layout the neighbour
  * loop reads on lanes (thermal = T, k, V blocks of `stride` floats). Moving water takes its volume from
  * the summation density; static particles, and every particle when the flow is off, from rho0. */
+/* THAW_MELT_SHIFT (substances that lower the melting point, sim/substance_stage.h): how far below its material's
+ * melting point each particle melts and freezes [K], from the water it holds or, for ice, the water around it
+ * (substance.cl); the law is thermal_law.h's thermal_temperature_lowered. */
+#ifdef THAW_MELT_SHIFT
+#define MELT_SHIFT(i) melt_shift[i]
+#else
+#define MELT_SHIFT(i) 0.0f
+#endif
+
 kernel void thermal_state(global const float4* pos, global const float* density, global const float2* enthalpy,
                           global const uchar* phase, global const uchar* material,
-                          global const MaterialThermal* materials, global float* thermal, const HeatParams P) {
+                          global const MaterialThermal* materials, global float* thermal, const HeatParams P,
+                          global const float* melt_shift) {
   const uint i = get_global_id(0);
   const uint stride = P.stride, n = P.n, flow = P.flow;
   const float rho0 = P.rest_density;
@@ -24,14 +34,24 @@ kernel void thermal_state(global const float4* pos, global const float* density,
   const float2 e = enthalpy[i];
   const float h = e.x + e.y;
   const float rho = (flow && !THAW_IS_STATIC(phase[i])) ? density[i] : rho0;
+#ifdef THAW_MELT_SHIFT
+  const float d = m.latent > 0.0f ? MELT_SHIFT(i) : 0.0f;
+  thermal[i] = thermal_temperature_lowered(h, m.latent, m.melt, m.c_solid, m.c_liquid, d);
+  /* The front's conductivity (below) reads the liquid fraction as h / L: the same fraction under the
+   * lowered law. */
+  const float h_front = m.latent > 0.0f ? m.latent * thermal_liquid_fraction_lowered(h, m.latent, m.c_solid, m.c_liquid, d)
+                                        : h;
+#else
   thermal[i] = thermal_temperature(h, m.latent, m.melt, m.c_solid, m.c_liquid);
+  const float h_front = h;
+#endif
   /* A held particle is isothermal, as if it conducted without limit: the pair's harmonic mean then
    * tends to 2 k_j, the conductance of the neighbour's half of the path alone. With its own k instead,
    * a held wall took the resistance of a particle-wide layer (the front lagged about 0.4 spacings in
    * `thaw validate stefan`). 1e6 W/m/K is far above any real material and keeps the float sums finite. */
   thermal[stride + i] = (m.flags & THAW_MAT_HELD)
                             ? 1.0e6f
-                            : thermal_conductivity(h, m.latent, m.k_solid, m.k_liquid, phase[i] == THAW_PHASE_ICE);
+                            : thermal_conductivity(h_front, m.latent, m.k_solid, m.k_liquid, phase[i] == THAW_PHASE_ICE);
   thermal[2 * stride + i] = pos[i].w / rho;
 }
 
@@ -130,7 +150,7 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
                  global uchar* material, global const MaterialThermal* materials, global const float* soa,
                  global const float* thermal, global const uint* cell_start, const Grid g, const HeatParams P,
                  global const DryerJet* dryers, global float* lamp_energy, global float* budget,
-                 global uint* phase_changed, global const float* area) {
+                 global uint* phase_changed, global const float* area, global const float* melt_shift) {
   const float H = P.support, eta2 = P.eta2, exposed_r2 = P.exposed_r2, face_area = P.face_area;
   const float ambient_temperature = P.ambient_temperature, ambient_coefficient = P.ambient_coefficient;
   const float dt_heat = P.dt_heat;
@@ -255,8 +275,11 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
   const float h = e.x + e.y;
   const uchar ph = phase[i];
   int to = -1;
-  if ((m.flags & THAW_MAT_MELTS) && ph == THAW_PHASE_ICE && h >= m.latent) to = THAW_PHASE_WATER;
-  if ((m.flags & THAW_MAT_FREEZES) && ph == THAW_PHASE_WATER && h <= 0.0f) to = THAW_PHASE_ICE;
+  const float shift = MELT_SHIFT(i);
+  if ((m.flags & THAW_MAT_MELTS) && ph == THAW_PHASE_ICE && h >= thermal_liquid_limit(m.latent, m.c_liquid, shift))
+    to = THAW_PHASE_WATER;
+  if ((m.flags & THAW_MAT_FREEZES) && ph == THAW_PHASE_WATER && h <= thermal_solid_limit(m.c_solid, shift))
+    to = THAW_PHASE_ICE;
   if (to >= 0) {
     const MaterialThermal other = materials[m.partner];
     phase[i] = (uchar)to;

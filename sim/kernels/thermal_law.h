@@ -58,6 +58,29 @@ THAW_TL_FN THAW_TL_REAL thermal_enthalpy(THAW_TL_REAL T, int liquid, THAW_TL_REA
   return liquid ? latent + c_liquid * (T - melt) : c_solid * (T - melt);
 }
 
+/* With the melting point lowered by d >= 0 (a dissolved substance, Blagden's law: docs/SUBSTANCES.md): each
+ * pure phase keeps its enthalpy curve, c_solid (T - T_m) below and L + c_liquid (T - T_m) above, and the two
+ * meet at T_m - d, where the solid has -c_solid d and the liquid L - c_liquid d. Between those the particle
+ * is at T_m - d, part melted. d = 0 is the law above; a particle keeps its h, so energy is conserved
+ * whatever d does. */
+THAW_TL_FN THAW_TL_REAL thermal_solid_limit(THAW_TL_REAL c_solid, THAW_TL_REAL d) { return -c_solid * d; }
+THAW_TL_FN THAW_TL_REAL thermal_liquid_limit(THAW_TL_REAL latent, THAW_TL_REAL c_liquid, THAW_TL_REAL d) {
+  return latent - c_liquid * d;
+}
+THAW_TL_FN THAW_TL_REAL thermal_temperature_lowered(THAW_TL_REAL h, THAW_TL_REAL latent, THAW_TL_REAL melt,
+                                                    THAW_TL_REAL c_solid, THAW_TL_REAL c_liquid,
+                                                    THAW_TL_REAL d) {
+  return h < -c_solid * d ? melt + h / c_solid
+                          : (h > latent - c_liquid * d ? melt + (h - latent) / c_liquid : melt - d);
+}
+/* The liquid fraction under the same law (materials that change phase). */
+THAW_TL_FN THAW_TL_REAL thermal_liquid_fraction_lowered(THAW_TL_REAL h, THAW_TL_REAL latent,
+                                                        THAW_TL_REAL c_solid, THAW_TL_REAL c_liquid,
+                                                        THAW_TL_REAL d) {
+  const THAW_TL_REAL lo = -c_solid * d, hi = latent - c_liquid * d;
+  return h <= lo ? 0 : (h >= hi ? 1 : (h - lo) / (hi - lo));
+}
+
 /* Conductivity of a particle. At the melting point the particle holds the front: it is part converted
  * (the phase forming: liquid while an ice particle melts, solid while a water particle freezes) and
  * pinned at T_m, so the temperature drop to a converted neighbour happens over the distance to the

@@ -61,6 +61,9 @@ ValidationCase ambient_sphere_case();
 ValidationCase laplace_case();
 ValidationCase drop_oscillation_case();
 ValidationCase contact_angle_case();
+ValidationCase diffusion_bulk_case();
+ValidationCase brine_melting_case();
+ValidationCase conservation_case();
 
 // A scene of ice held in still air, for the surface cases (sim/validation/surface_area.cpp): the cube
 // [-half, half]^3 at spacing dx without gravity, the ambient at air_temperature through h, heat.exposed_area

@@ -1,0 +1,188 @@
+#include "sim/substance_stage.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "sim/cl_launch.h"
+#include "sim/solver.h"
+#include "sim/thermal.h"
+
+namespace thaw {
+
+FieldSpec substance_field(const std::string& name) {
+  return {kSubstancePrefix + name, FieldType::Float32, 2, true, false};
+}
+
+void add_substance_columns(HostParticles& p, const Scene& scene, const std::vector<std::size_t>& first_of,
+                           const std::vector<std::vector<double>>& concentrations) {
+  for (std::size_t s = 0; s < scene.substances.size(); ++s) {
+    HostColumn c{substance_field(scene.substances[s].name), {}};
+    c.bytes.assign(p.size() * c.spec.bytes(), 0);
+    Float2* q = c.as<Float2>();
+    for (std::size_t b = 0; b + 1 < first_of.size() && b < concentrations.size(); ++b) {
+      const double concentration = s < concentrations[b].size() ? concentrations[b][s] : 0.0;
+      if (concentration == 0.0) continue;
+      for (std::size_t i = first_of[b]; i < first_of[b + 1]; ++i) {
+        const double rho0 = scene.materials[p.material[i]].density;
+        const double amount = concentration * double(p.position[i][3]) / rho0;
+        const float hi = static_cast<float>(amount);
+        q[i] = {hi, static_cast<float>(amount - double(hi))};
+      }
+    }
+    p.columns.push_back(std::move(c));
+  }
+  // Where substances lower the melting point, the shift the solution starts with (wholly liquid: the scene
+  // loader keeps fluids above their lowered melting point), which the first step's partly frozen check reads.
+  if (substances_lower_melting(scene)) {
+    HostColumn c{{kMeltShiftField, FieldType::Float32, 1, true, true}, {}};
+    c.bytes.assign(p.size() * 4, 0);
+    for (std::size_t b = 0; b + 1 < first_of.size() && b < concentrations.size(); ++b)
+      for (std::size_t i = first_of[b]; i < first_of[b + 1]; ++i)
+        c.as<float>()[i] = static_cast<float>(melting_point_drop(scene, p.material[i], concentrations[b]));
+    p.columns.push_back(std::move(c));
+  }
+}
+
+namespace {
+
+bool has_ice_pair(const Scene& scene) {
+  return std::any_of(scene.materials.begin(), scene.materials.end(),
+                     [](const Material& m) { return m.kind == MaterialKind::Ice && m.partner >= 0; });
+}
+
+}  // namespace
+
+bool substances_lower_melting(const Scene& scene) {
+  return scene.heat.enabled && has_ice_pair(scene) &&
+         std::any_of(scene.substances.begin(), scene.substances.end(),
+                     [](const Substance& s) { return s.lowers_melting_point(); });
+}
+
+bool substances_rejected_by_ice(const Scene& scene) {
+  return scene.heat.enabled && has_ice_pair(scene) &&
+         std::any_of(scene.substances.begin(), scene.substances.end(),
+                     [](const Substance& s) { return !s.enters_ice; });
+}
+
+SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core,
+                               const Scene& scene, const SolverConstants& k, const std::string& build_options,
+                               const ParticleLayout& layout, const ParticleStore::Field* enthalpy)
+    : cl_(cl), store_(store), core_(core), scene_(scene), layout_(layout) {
+  for (const Substance& s : scene.substances) {
+    fields_.push_back(store.add(substance_field(s.name)));
+    diffusivity_.push_back(s.diffusivity);
+  }
+  // Saved where it lowers melting points: partly melted ice reads its last shift before renewing it.
+  const bool lowers = enthalpy && substances_lower_melting(scene),
+             rejects = enthalpy && substances_rejected_by_ice(scene);
+  shift_ = store.add({kMeltShiftField, FieldType::Float32, 1, lowers, lowers});
+  std::string opts = build_options + " -DTHAW_NSUB=" + std::to_string(scene.substances.size());
+  if (lowers) opts += " -DTHAW_MELT_SHIFT";
+  if (rejects) opts += " -DTHAW_REJECT";
+  ice_pass_ = lowers || rejects;
+  if (enthalpy) enthalpy_ = *enthalpy;
+  for (int a = 0; a < 3; ++a)
+    if (scene.solver.periodic[static_cast<std::size_t>(a)])
+      opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
+  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h",
+                                 "thermal_law.h", "substance_params.h", "substance.cl"},
+                                opts);
+  k_state_ = cl::Kernel(program, "substance_state");
+  if (ice_pass_) k_ice_ = cl::Kernel(program, "substance_ice");
+  k_diffuse_ = cl::Kernel(program, "substance_diffuse");
+
+  // Zeros past the particles too: the walk's lanes read a few floats beyond each cell's last one.
+  const std::size_t bytes = std::size_t(layout.stride) * (2 + scene.substances.size()) * 4;
+  sub_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, bytes);
+  cl.queue().enqueueFillBuffer(sub_, 0.0f, 0, bytes);
+  // Each material's rest density and cryoscopic constant (ice: that of the water it melts into).
+  std::vector<float> fluid;
+  for (const Material& m : scene.materials) {
+    const Material* solvent = m.kind == MaterialKind::Fluid ? &m
+                              : m.kind == MaterialKind::Ice && m.partner >= 0
+                                  ? &scene.materials[static_cast<std::size_t>(m.partner)]
+                                  : nullptr;
+    fluid.push_back(static_cast<float>(m.density));
+    fluid.push_back(static_cast<float>(solvent ? solvent->cryoscopic_constant : 0.0));
+  }
+  fluid_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, fluid.size() * 4, fluid.data());
+  std::vector<float> law;  // each material's L, c_solid, c_liquid and physical over SPH mass
+  for (const thermal::MaterialThermal& m : material_thermal_table(scene, k.rest_density))
+    law.insert(law.end(), {m.latent, m.c_solid, m.c_liquid, m.thermal_mass_scale});
+  law_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, law.size() * 4, law.data());
+
+  params_.support = k.support;
+  params_.eta2 = 0.01f * k.smoothing * k.smoothing;
+  float* period[3] = {&params_.period_x, &params_.period_y, &params_.period_z};
+  for (int a = 0; a < 3; ++a)
+    if (scene.solver.periodic[static_cast<std::size_t>(a)])
+      *period[a] = static_cast<float>(scene.domain.max[a] - scene.domain.min[a]);
+  params_.flow = scene.solver.flow ? 1u : 0u;
+  params_.max_shift = static_cast<float>(kMaxMeltingPointDrop);
+  float* moles[4] = {&params_.moles0, &params_.moles1, &params_.moles2, &params_.moles3};
+  for (std::size_t s = 0; s < scene.substances.size(); ++s) {
+    const Substance& sub = scene.substances[s];
+    if (sub.lowers_melting_point()) *moles[s] = static_cast<float>(sub.dissociation / sub.molar_mass);
+    if (!sub.enters_ice) params_.reject |= 1u << s;
+  }
+
+  // Explicit diffusion is stable for D dt / h^2 below about 1/6 in 3-D; heat keeps the same margin.
+  const double D = diffusivity_.empty() ? 0.0 : *std::max_element(diffusivity_.begin(), diffusivity_.end());
+  const double h = k.smoothing;
+  max_dt_ = D > 0 ? scene.solver.diffusion_number * h * h / D : std::numeric_limits<double>::infinity();
+}
+
+const cl::Buffer& SubstanceStage::amount(std::size_t s) const {
+  return store_[fields_[std::min(s, fields_.size() - 1)]];
+}
+
+void SubstanceStage::prepare(const NeighbourView& nv) {
+  if (layout_.n == 0) return;
+  auto& q = cl_.queue();
+  params_.stride = layout_.stride;
+  params_.n = static_cast<cl_uint>(layout_.n);
+  // Slots past the scene's substances take the first one's buffer: the kernels never touch them.
+  // Without the ice pass the kernel never reads the enthalpy; any buffer fills the argument.
+  set_args(k_state_, store_[core_.position], store_[core_.density], ice_pass_ ? store_[enthalpy_] : sub_,
+           store_[core_.phase], store_[core_.material], fluid_, law_, sub_, store_[shift_], amount(0),
+           amount(1), amount(2), amount(3), params_);
+  launch(q, k_state_, layout_.n);
+  if (ice_pass_) {
+    set_args(k_ice_, store_[core_.position], store_[core_.phase], store_[core_.material], fluid_, law_,
+             store_[enthalpy_], nv.soa, sub_, store_[shift_], nv.cell_start, nv.grid, amount(0), amount(1),
+             amount(2), amount(3), params_);
+    launch(q, k_ice_, layout_.n);
+  }
+}
+
+void SubstanceStage::diffuse(double dt, const NeighbourView& nv) {
+  if (layout_.n == 0 || dt <= 0) return;
+  // 4 D dt of each substance: the pair term's constant for this step with the kernel's sigma / H^2
+  // (substance.cl).
+  float* step[4] = {&params_.step0, &params_.step1, &params_.step2, &params_.step3};
+  for (std::size_t s = 0; s < 4; ++s)
+    *step[s] = s < diffusivity_.size() ? static_cast<float>(4.0 * diffusivity_[s] * dt) : 0.0f;
+  set_args(k_diffuse_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_, amount(0),
+           amount(1), amount(2), amount(3));
+  launch(cl_.queue(), k_diffuse_, layout_.n);
+}
+
+std::vector<float> SubstanceStage::melt_shifts() const {
+  std::vector<float> out(layout_.n);
+  if (!out.empty()) cl_.queue().enqueueReadBuffer(store_[shift_], CL_TRUE, 0, out.size() * 4, out.data());
+  return out;
+}
+
+std::vector<double> SubstanceStage::totals() const {
+  std::vector<double> out(fields_.size(), 0.0);
+  const std::size_t n = layout_.n;
+  if (n == 0) return out;
+  std::vector<Float2> a(n);
+  for (std::size_t s = 0; s < fields_.size(); ++s) {
+    cl_.queue().enqueueReadBuffer(store_[fields_[s]], CL_TRUE, 0, n * sizeof(Float2), a.data());
+    for (const Float2& v : a) out[s] += double(v[0]) + double(v[1]);
+  }
+  return out;
+}
+
+}  // namespace thaw

@@ -1,0 +1,88 @@
+#pragma once
+// The substance stage (issue 20, docs/SUBSTANCES.md): substances dissolved in the water, each water
+// particle holding its amount of each as a field "substance_<name>" (kg, a compensated pair hi + lo), carried
+// by the flow and diffused between water particles by Fick's law in Cleary & Monaghan's pairwise form
+// (sim/kernels/substance.cl), conserving each substance's total to round-off. Built by the solver only when
+// the scene declares substances.
+#include <CL/opencl.hpp>
+#include <string>
+#include <vector>
+
+#include "sim/cl_runtime.h"
+#include "sim/kernels/substance_params.h"
+#include "sim/particle_store.h"
+#include "sim/scene.h"
+#include "sim/stage.h"
+
+namespace thaw {
+
+struct SolverConstants;
+
+// The field that holds each particle's amount of substance `name` [kg]: two floats (hi, lo), saved; the VTU
+// export shows it as the mass fraction, amount over the particle's mass (sim/particle_export.cpp).
+FieldSpec substance_field(const std::string& name);
+inline constexpr const char* kSubstancePrefix = "substance_";
+inline constexpr const char* kMeltShiftField = "melt_shift";
+
+// Whether the scene's substances lower the melting point where it matters: some substance has a molar mass,
+// and some water can melt from or freeze into ice. The heat stage then reads the substance stage's melt
+// shift (heat.cl, THAW_MELT_SHIFT).
+bool substances_lower_melting(const Scene& scene);
+// Whether water that freezes gives substances up: some substance does not enter ice, and the scene has ice
+// for water to freeze into.
+bool substances_rejected_by_ice(const Scene& scene);
+
+// Gives particles their substances: each particle of range b, [first_of[b], first_of[b + 1]), the
+// concentrations[b] of each substance [kg/m^3] times its volume (mass over its material's rest density);
+// particles past the ranges none. For the fluid blocks a scene samples and what its emitters pour.
+void add_substance_columns(HostParticles& p, const Scene& scene, const std::vector<std::size_t>& first_of,
+                           const std::vector<std::vector<double>>& concentrations);
+
+class SubstanceStage {
+ public:
+  // `scene` must outlive the stage (the solver's own copy). `enthalpy`: the heat stage's field, null without
+  // heat (then nothing melts or freezes, and neither the melt shift nor ice giving substances up is built).
+  SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
+                 const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
+                 const ParticleStore::Field* enthalpy);
+
+  // The amount field of each of the scene's substances, in its order.
+  const std::vector<ParticleStore::Field>& fields() const { return fields_; }
+
+  // The diffusion's limit on dt [s]: solver.diffusion_number h^2 / D of the fastest substance.
+  double max_dt() const { return max_dt_; }
+
+  // Before the heat pass: each particle's mass fraction, and where substances lower the melting point, its
+  // melt shift (ice's from the water around it); with ice that water froze into, what that ice gives up.
+  void prepare(const NeighbourView& nv);
+  // After the heat pass: diffuses every substance over a step of dt, and hands what freezing ice gives up
+  // to the water around it.
+  void diffuse(double dt, const NeighbourView& nv);
+
+  // How far below its material's melting point each particle melts [K] (prepare), for the heat stage: the
+  // field "melt_shift", not saved (prepare computes it before the heat pass reads it), exported.
+  ParticleStore::Field melt_shift() const { return shift_; }
+  // The melt shift of each particle as the last prepare() left it [K]; empty without a melt shift.
+  std::vector<float> melt_shifts() const;
+
+  // Each substance's total over all particles [kg], summed in double from the device's pairs.
+  std::vector<double> totals() const;
+
+ private:
+  ClRuntime& cl_;
+  ParticleStore& store_;
+  CoreFields core_;
+  const Scene& scene_;
+  const ParticleLayout& layout_;  // the solver's: the particle count changes when water leaves
+  std::vector<ParticleStore::Field> fields_;
+  std::vector<double> diffusivity_;
+  double max_dt_ = 0;
+  substance::SubstanceParams params_{};
+  bool ice_pass_ = false;  // substance_ice is built: the melt shift or ice giving substances up
+  cl::Kernel k_state_, k_ice_, k_diffuse_;
+  ParticleStore::Field shift_ = 0, enthalpy_ = 0;
+  cl::Buffer sub_, fluid_, law_;
+  const cl::Buffer& amount(std::size_t s) const;  // substance s's field, or the first's past the last
+};
+
+}  // namespace thaw
