@@ -157,11 +157,11 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
 
 void SubstanceStage::diffuse(double dt, const NeighbourView& nv) {
   if (layout_.n == 0 || dt <= 0) return;
-  // 4 D dt of each substance: the pair term's constant for this step with the kernel's sigma / H^2
+  // 2 D dt of each substance: the pair term's constant for this step with the kernel's sigma / H^2
   // (substance.cl).
   float* step[4] = {&params_.step0, &params_.step1, &params_.step2, &params_.step3};
   for (std::size_t s = 0; s < 4; ++s)
-    *step[s] = s < diffusivity_.size() ? static_cast<float>(4.0 * diffusivity_[s] * dt) : 0.0f;
+    *step[s] = s < diffusivity_.size() ? static_cast<float>(2.0 * diffusivity_[s] * dt) : 0.0f;
   set_args(k_diffuse_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_, amount(0),
            amount(1), amount(2), amount(3));
   launch(cl_.queue(), k_diffuse_, layout_.n);

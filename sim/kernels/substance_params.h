@@ -12,7 +12,7 @@ typedef struct {
   float support;                      /* kernel support H [m] */
   float eta2;                         /* 0.01 h^2, keeps the pair term finite at r -> 0 [m^2] */
   float period_x, period_y, period_z; /* domain length along each periodic axis, 0 elsewhere [m] */
-  /* Each substance's 4 D dt [m^2] for a step of dt (the pair term's constant is this times sigma / H^2). */
+  /* Each substance's 2 D dt [m^2] for a step of dt (the pair term's constant is this times sigma / H^2). */
   float step0, step1, step2, step3;
   /* Each substance's van 't Hoff factor over its molar mass, i / M [mol/kg]; 0 where it does not lower the
    * melting point. */
