@@ -102,6 +102,17 @@ float own_shift(float h, float4 l, float m, float Q, float Kn, float dmax) {
   return 0.5f * (lo + hi);
 }
 
+/* What particle i holds: (kg of substances, moles of the particles they make in solution, i / M each). */
+float2 solutes(global const float2* q[4], const uint i, const SubstanceParams P) {
+  const float moles[4] = {P.moles0, P.moles1, P.moles2, P.moles3};
+  float2 held = (float2)(0.0f);
+  for (int s = 0; s < THAW_NSUB; ++s) {
+    const float amount = q[s][i].x + q[s][i].y;
+    held += (float2)(amount, moles[s] * amount);
+  }
+  return held;
+}
+
 kernel void substance_state(global const float4* pos, global const float* density, global const float2* enthalpy,
                             global const uchar* phase, global const uchar* material, global const float2* fluid,
                             global const float4* law, global float* sub, global float* shift,
@@ -115,13 +126,8 @@ kernel void substance_state(global const float4* pos, global const float* densit
   const float2 f = fluid[mi];
   const int water = phase[i] == THAW_PHASE_WATER && m > 0.0f;
   global const float2* q[4] = {q0, q1, q2, q3};
-  const float moles[4] = {P.moles0, P.moles1, P.moles2, P.moles3};
-  float dissolved = 0.0f, particles = 0.0f;
-  for (int s = 0; s < THAW_NSUB; ++s) {
-    const float2 a = q[s][i];
-    dissolved += a.x + a.y;
-    particles += moles[s] * (a.x + a.y);
-  }
+  const float2 held = solutes(q, i, P);
+  const float dissolved = held.x, particles = held.y;
   float carried = water ? m : 0.0f;
 #if defined(THAW_MELT_SHIFT) || defined(THAW_REJECT)
   const float4 l = law[mi];
@@ -206,16 +212,10 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
    * cap while it has none, so it melts until its melt holds the salt as brine at its own liquidus. `fluid`
    * gives ice the cryoscopic constant of the water it melts into. */
   global const float2* qs[4] = {q0, q1, q2, q3};
-  const float moles[4] = {P.moles0, P.moles1, P.moles2, P.moles3};
-  float dissolved = 0.0f, solute = 0.0f;
-  for (int s = 0; s < THAW_NSUB; ++s) {
-    const float2 a = qs[s][i];
-    dissolved += a.x + a.y;
-    solute += moles[s] * (a.x + a.y);
-  }
+  const float2 held = solutes(qs, i, P);
   const float4 l = law[material[i]];
   const float2 e = enthalpy[i];
-  const float own = own_shift(e.x + e.y, l, pi.w * l.w, dissolved, fluid[material[i]].y * solute, P.max_shift);
+  const float own = own_shift(e.x + e.y, l, pi.w * l.w, held.x, fluid[material[i]].y * held.y, P.max_shift);
   shift[i] = fmax(around, own);
 #else
   shift[i] = around;
