@@ -66,6 +66,14 @@ float2 lanes_compensated(floatV hi, floatV lo) {
   return (float2)(s, e);
 }
 
+/* Inside a walk over candidates j..: the lanes' squared distance r2 from pi, along periodic axes the minimum
+ * image's (X, Y, Z: the reorder's position blocks). The same operations on both sides of every pair. */
+#define PAIR_LANES(pi, j, period)                                          \
+  const floatV dx = THAW_WRAP((pi).x - vloadV(0, X + (j)), (period).x); \
+  const floatV dy = THAW_WRAP((pi).y - vloadV(0, Y + (j)), (period).y); \
+  const floatV dz = THAW_WRAP((pi).z - vloadV(0, Z + (j)), (period).z); \
+  const floatV r2 = dx * dx + dy * dy + dz * dz;
+
 /* hi, lo += d on every lane, compensated (Knuth's two-sum). */
 #define ACCUMULATE(hi, lo, d)                  \
   {                                            \
@@ -186,10 +194,7 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
   floatV sw = (floatV)(0.0f), sww = (floatV)(0.0f), sd = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = THAW_WRAP(pi.x - vloadV(0, X + j), period.x);
-      const floatV dy = THAW_WRAP(pi.y - vloadV(0, Y + j), period.y);
-      const floatV dz = THAW_WRAP(pi.z - vloadV(0, Z + j), period.z);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      PAIR_LANES(pi, j, period)
       const intV near = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
       /* Carriers (water, and ice partly melted) take its shares; water alone sets its shift (the partly
        * melted ice's own shifts are being renewed by this pass). */
@@ -270,10 +275,7 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
   }
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = THAW_WRAP(pi.x - vloadV(0, X + j), period.x);
-      const floatV dy = THAW_WRAP(pi.y - vloadV(0, Y + j), period.y);
-      const floatV dz = THAW_WRAP(pi.z - vloadV(0, Z + j), period.z);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
+      PAIR_LANES(pi, j, period)
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
       const floatV mj = vloadV(0, M + j);
       if (!giving) {

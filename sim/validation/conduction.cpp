@@ -89,47 +89,33 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
     p.enthalpy[i] = {hi, static_cast<float>(h - hi)};
   }
 
-  // Second moment of the excess, weighted by volume (equal volumes here).
-  auto moment = [&](const HostParticles& q, const std::vector<float>& T) {
-    double m0 = 0, m2 = 0;
-    for (std::size_t i = 0; i < q.size(); ++i) {
-      const double e = T[i] - pulse.background;
-      const double r2 = double(q.position[i][0]) * q.position[i][0] + double(q.position[i][1]) * q.position[i][1] +
-                        double(q.position[i][2]) * q.position[i][2];
-      m0 += e;
-      m2 += e * r2;
-    }
-    return m2 / m0;
-  };
+  auto as_double = [](const std::vector<float>& v) { return std::vector<double>(v.begin(), v.end()); };
 
   Solver solver(cl, scene, st);
   solver.warm_up();
-  const double m2_start = moment(solver.particles(), solver.temperatures());
+  const double m2_start = pulse.second_moment(solver.particles().position, as_double(solver.temperatures()));
   const auto t0 = std::chrono::steady_clock::now();
   // The reference is evaluated at the time actually reached (the last step may pass t_end).
   while (solver.time() < t_end * (1.0 - 1e-12)) solver.step();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const HostParticles q = solver.particles();
-  const std::vector<float> T = solver.temperatures();
+  const std::vector<double> T = as_double(solver.temperatures());
   const double t = solver.time();
-  double err2 = 0, ref2 = 0, heat = 0;
+  double heat = 0;
   for (std::size_t i = 0; i < q.size(); ++i) {
     const double r2 = double(q.position[i][0]) * q.position[i][0] + double(q.position[i][1]) * q.position[i][1] +
                       double(q.position[i][2]) * q.position[i][2];
-    const double exact = pulse.temperature(r2, t);
-    err2 += (T[i] - exact) * (T[i] - exact);
-    ref2 += (exact - pulse.background) * (exact - pulse.background);
-    heat += double(q.position[i][3]) * c * std::abs(exact - pulse.background);
+    heat += double(q.position[i][3]) * c * std::abs(pulse.temperature(r2, t) - pulse.background);
   }
-  const double alpha_eff = (moment(q, T) - m2_start) / (2.0 * 3.0 * t);
+  const double alpha_eff = (pulse.second_moment(q.position, T) - m2_start) / (2.0 * 3.0 * t);
   const double closure = solver.total_enthalpy() - solver.energy_budget().initial - solver.energy_budget().heat_in();
 
   CaseResult r;
   r.particles = q.size();
   r.steps = solver.steps();
   r.wall_s = wall;
-  const double l2 = std::sqrt(err2 / ref2);
+  const double l2 = pulse.l2_error(q.position, T, t);
   r.metrics = {
       {"temperature_l2", {l2, 0.0, l2, jitter > 0 ? double(prm["l2_gate_jittered"]) : double(prm["l2_gate"])}},
       {"effective_diffusivity",

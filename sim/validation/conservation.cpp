@@ -81,7 +81,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
       {"ice",
        {{{"material", "ice"},
          {"box", {{"min", {0.02, 0.006, 0.0}}, {"max", {0.02 + side, 0.006 + side, side}}}},
-         {"temperature", -5.0}}}},
+         // At its melting point, so the brine's first touch melts it, however the flow goes.
+         {"temperature", 0.0}}}},
       // Fresh dyed water over the cold plate freezes (brine would not freeze through: docs/SUBSTANCES.md);
       // dyed brine beside the ice melts it.
       {"fluids",
@@ -91,7 +92,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
          {"substances", {{"dye", {{"concentration", prm["dye"]}}}}}},
         {{"material", "water"},
          {"box", {{"min", {0.012, 0.0, 0.0}}, {"max", {0.02, 0.02, 0.016}}}},
-         {"temperature", 5.0},
+         {"temperature", 10.0},
          {"substances",
           {{"salt", {{"concentration", prm["salinity"]}}}, {"dye", {{"concentration", prm["dye"]}}}}}}}},
       {"emitters",

@@ -112,20 +112,10 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
     for (std::size_t i = 0; i < h.size(); ++i) w[i] = (double(a[i][0]) + double(a[i][1])) / h.position[i][3];
     return w;
   };
-  auto moment = [&](const HostParticles& h, const std::vector<double>& w) {
-    double m0 = 0, m2 = 0;
-    for (std::size_t i = 0; i < h.size(); ++i) {
-      const double e = w[i] - pulse.background;
-      m0 += e;
-      m2 += e * r2_of(h.position[i]);
-    }
-    return m2 / m0;
-  };
-
   Solver solver(cl, scene, st);
   solver.warm_up();
   const HostParticles start = solver.particles();
-  const double m2_start = moment(start, fractions(start));
+  const double m2_start = pulse.second_moment(start.position, fractions(start));
   const auto t0 = std::chrono::steady_clock::now();
   while (solver.time() < t_end * (1.0 - 1e-12)) solver.step();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -133,13 +123,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const HostParticles end = solver.particles();
   const std::vector<double> w = fractions(end);
   const double t = solver.time();
-  double err2 = 0, ref2 = 0;
-  for (std::size_t i = 0; i < end.size(); ++i) {
-    const double exact = pulse.temperature(r2_of(end.position[i]), t);
-    err2 += (w[i] - exact) * (w[i] - exact);
-    ref2 += (exact - pulse.background) * (exact - pulse.background);
-  }
-  const double d_eff = (moment(end, w) - m2_start) / (2.0 * 3.0 * t);
+  const double d_eff = (pulse.second_moment(end.position, w) - m2_start) / (2.0 * 3.0 * t);
   const double total = solver.substance_totals().at(0), initial = solver.substance_books().initial.at(0);
   const double closure = total - initial;
 
@@ -147,7 +131,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   r.particles = end.size();
   r.steps = solver.steps();
   r.wall_s = wall;
-  const double l2 = std::sqrt(err2 / ref2);
+  const double l2 = pulse.l2_error(end.position, w, t);
   r.metrics = {
       {"fraction_l2", {l2, 0.0, l2, jitter > 0 ? double(prm["l2_gate_jittered"]) : double(prm["l2_gate"])}},
       {"effective_diffusivity",

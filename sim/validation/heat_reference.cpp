@@ -141,6 +141,30 @@ double GaussianPulse::temperature(double r2, double t) const {
   return background + amplitude * std::pow(sigma0 * sigma0 / v, 0.5 * dimensions) * std::exp(-r2 / (2.0 * v));
 }
 
+namespace {
+double radius2(const Float4& x) { return double(x[0]) * x[0] + double(x[1]) * x[1] + double(x[2]) * x[2]; }
+}  // namespace
+
+double GaussianPulse::second_moment(const std::vector<Float4>& x, const std::vector<double>& value) const {
+  double m0 = 0, m2 = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double e = value[i] - background;
+    m0 += e;
+    m2 += e * radius2(x[i]);
+  }
+  return m2 / m0;
+}
+
+double GaussianPulse::l2_error(const std::vector<Float4>& x, const std::vector<double>& value, double t) const {
+  double err2 = 0, ref2 = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double exact = temperature(radius2(x[i]), t);
+    err2 += (value[i] - exact) * (value[i] - exact);
+    ref2 += (exact - background) * (exact - background);
+  }
+  return std::sqrt(err2 / ref2);
+}
+
 double GaussianPulse::excess_heat() const {
   return amplitude * std::pow(2.0 * std::numbers::pi * sigma0 * sigma0, 0.5 * dimensions);
 }

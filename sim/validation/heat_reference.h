@@ -3,6 +3,10 @@
 // against (docs/VALIDATION-RESULTS.md: conduction and Stefan). They are computed from the case's own parameters, so a
 // case whose materials or temperatures are overridden still has its reference.
 
+#include <vector>
+
+#include "sim/particles.h"
+
 namespace thaw {
 
 // Thermal properties of one phase.
@@ -68,6 +72,13 @@ struct GaussianPulse {
   double temperature(double r2, double t) const;  // r2 = |x - centre|^2
   double variance(double t) const;                // s0^2 + 2 alpha t
   double excess_heat() const;                     // integral of (T - T_inf) dV, per unit rho c
+
+  // A field sampled on particles of equal volume at `x` (the centre at the origin), such as the
+  // conduction case's temperatures or the diffusion case's mass fractions: the second moment of its excess
+  // over the background, whose growth 2 d alpha t measures the effective diffusivity; and its L2 error
+  // against the pulse at time t, relative to the pulse's excess.
+  double second_moment(const std::vector<Float4>& x, const std::vector<double>& value) const;
+  double l2_error(const std::vector<Float4>& x, const std::vector<double>& value, double t) const;
 };
 
 }  // namespace thaw
