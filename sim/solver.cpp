@@ -384,8 +384,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
     substances_ = std::make_unique<SubstanceStage>(cl_, store_, f_, scene_, k_, opts, layout_,
                                                    heat_ ? &enthalpy : nullptr);
   }
-  if (heat_ && substances_ && substances_lower_melting(scene_))
-    heat_->melt_shift_from(substances_->melt_shift());
+  if (substances_ && substances_->lowers_melting()) heat_->melt_shift_from(substances_->melt_shift());
   if (fluid_ && heat_) fluid_->buoyancy_from(heat_->enthalpy());
   if (dfsph_ && heat_) dfsph_->rest_density_from(heat_->enthalpy());
   store_.allocate(layout_.capacity);
@@ -967,8 +966,7 @@ std::vector<double> Solver::substance_totals() const {
 }
 
 std::vector<float> Solver::melt_shifts() const {
-  return substances_ && heat_ && substances_lower_melting(scene_) ? substances_->melt_shifts()
-                                                                  : std::vector<float>{};
+  return substances_ ? substances_->melt_shifts() : std::vector<float>{};
 }
 
 std::vector<std::uint32_t> Solver::cell_starts() const { return grid_->cell_starts(); }

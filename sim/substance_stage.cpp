@@ -13,6 +13,8 @@ FieldSpec substance_field(const std::string& name) {
   return {kSubstancePrefix + name, FieldType::Float32, 2, true, false};
 }
 
+FieldSpec melt_shift_field() { return {kMeltShiftField, FieldType::Float32, 1, true, true}; }
+
 void add_substance_columns(HostParticles& p, const Scene& scene, const std::vector<std::size_t>& first_of,
                            const std::vector<std::vector<double>>& concentrations) {
   for (std::size_t s = 0; s < scene.substances.size(); ++s) {
@@ -34,7 +36,7 @@ void add_substance_columns(HostParticles& p, const Scene& scene, const std::vect
   // Where substances lower the melting point, the shift the solution starts with (wholly liquid: the scene
   // loader keeps fluids above their lowered melting point), which the first step's partly frozen check reads.
   if (substances_lower_melting(scene)) {
-    HostColumn c{{kMeltShiftField, FieldType::Float32, 1, true, true}, {}};
+    HostColumn c{melt_shift_field(), {}};
     c.bytes.assign(p.size() * 4, 0);
     for (std::size_t b = 0; b + 1 < first_of.size() && b < concentrations.size(); ++b)
       for (std::size_t i = first_of[b]; i < first_of[b + 1]; ++i)
@@ -72,14 +74,16 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
     fields_.push_back(store.add(substance_field(s.name)));
     diffusivity_.push_back(s.diffusivity);
   }
-  // Saved where it lowers melting points: partly melted ice reads its last shift before renewing it.
-  const bool lowers = enthalpy && substances_lower_melting(scene),
-             rejects = enthalpy && substances_rejected_by_ice(scene);
-  shift_ = store.add({kMeltShiftField, FieldType::Float32, 1, lowers, lowers});
+  // The shift is a field wherever the scene's substances lower the melting point (a state file keeps it for
+  // the temperatures it shows), and renewed here only where heat reads it.
+  has_shift_ = substances_lower_melting(scene);
+  if (has_shift_) shift_ = store.add(melt_shift_field());
+  lowers_ = enthalpy && has_shift_;
+  const bool rejects = enthalpy && substances_rejected_by_ice(scene);
   std::string opts = build_options + " -DTHAW_NSUB=" + std::to_string(scene.substances.size());
-  if (lowers) opts += " -DTHAW_MELT_SHIFT";
+  if (lowers_) opts += " -DTHAW_MELT_SHIFT";
   if (rejects) opts += " -DTHAW_REJECT";
-  ice_pass_ = lowers || rejects;
+  ice_pass_ = lowers_ || rejects;
   if (enthalpy) enthalpy_ = *enthalpy;
   for (int a = 0; a < 3; ++a)
     if (scene.solver.periodic[static_cast<std::size_t>(a)])
@@ -141,16 +145,17 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
   auto& q = cl_.queue();
   params_.stride = layout_.stride;
   params_.n = static_cast<cl_uint>(layout_.n);
-  // Slots past the scene's substances take the first one's buffer: the kernels never touch them.
-  // Without the ice pass the kernel never reads the enthalpy; any buffer fills the argument.
-  set_args(k_state_, store_[core_.position], store_[core_.density], ice_pass_ ? store_[enthalpy_] : sub_,
-           store_[core_.phase], store_[core_.material], fluid_, law_, sub_, store_[shift_], amount(0),
-           amount(1), amount(2), amount(3), params_);
+  // Slots past the scene's substances take the first one's buffer: the kernels never touch them. Without
+  // the ice pass the kernels never read the enthalpy, nor the shift without THAW_MELT_SHIFT; any buffer
+  // fills those arguments.
+  const cl::Buffer& enthalpy = ice_pass_ ? store_[enthalpy_] : sub_;
+  const cl::Buffer& shift = has_shift_ ? store_[shift_] : sub_;
+  set_args(k_state_, store_[core_.position], store_[core_.density], enthalpy, store_[core_.phase],
+           store_[core_.material], fluid_, law_, sub_, shift, amount(0), amount(1), amount(2), amount(3), params_);
   launch(q, k_state_, layout_.n);
   if (ice_pass_) {
-    set_args(k_ice_, store_[core_.position], store_[core_.phase], store_[core_.material], fluid_, law_,
-             store_[enthalpy_], nv.soa, sub_, store_[shift_], nv.cell_start, nv.grid, amount(0), amount(1),
-             amount(2), amount(3), params_);
+    set_args(k_ice_, store_[core_.position], store_[core_.phase], store_[core_.material], fluid_, law_, enthalpy,
+             nv.soa, sub_, shift, nv.cell_start, nv.grid, amount(0), amount(1), amount(2), amount(3), params_);
     launch(q, k_ice_, layout_.n);
   }
 }
@@ -168,7 +173,7 @@ void SubstanceStage::diffuse(double dt, const NeighbourView& nv) {
 }
 
 std::vector<float> SubstanceStage::melt_shifts() const {
-  std::vector<float> out(layout_.n);
+  std::vector<float> out(lowers_ ? layout_.n : 0);
   if (!out.empty()) cl_.queue().enqueueReadBuffer(store_[shift_], CL_TRUE, 0, out.size() * 4, out.data());
   return out;
 }

@@ -23,6 +23,9 @@ struct SolverConstants;
 FieldSpec substance_field(const std::string& name);
 inline constexpr const char* kSubstancePrefix = "substance_";
 inline constexpr const char* kMeltShiftField = "melt_shift";
+// The field of each particle's melt shift [K] where the scene's substances lower the melting point
+// (substances_lower_melting): saved, so partly melted ice resumes from its last shift, and exported.
+FieldSpec melt_shift_field();
 
 // Whether the scene's substances lower the melting point where it matters: some substance has a molar mass,
 // and some water can melt from or freeze into ice. The heat stage then reads the substance stage's melt
@@ -59,10 +62,11 @@ class SubstanceStage {
   // to the water around it.
   void diffuse(double dt, const NeighbourView& nv);
 
-  // How far below its material's melting point each particle melts [K] (prepare), for the heat stage: the
-  // field "melt_shift", not saved (prepare computes it before the heat pass reads it), exported.
+  // Whether this run lowers melting points: substances that do and the heat stage to read them (heat.cl's
+  // THAW_MELT_SHIFT). Then melt_shift() is the field [K] that prepare() renews before the heat pass.
+  bool lowers_melting() const { return lowers_; }
   ParticleStore::Field melt_shift() const { return shift_; }
-  // The melt shift of each particle as the last prepare() left it [K]; empty without a melt shift.
+  // The melt shift of each particle as the last prepare() left it [K]; empty unless lowers_melting().
   std::vector<float> melt_shifts() const;
 
   // Each substance's total over all particles [kg], summed in double from the device's pairs.
@@ -79,6 +83,7 @@ class SubstanceStage {
   double max_dt_ = 0;
   substance::SubstanceParams params_{};
   bool ice_pass_ = false;  // substance_ice is built: the melt shift or ice giving substances up
+  bool lowers_ = false, has_shift_ = false;  // THAW_MELT_SHIFT is built; the melt_shift field is declared
   cl::Kernel k_state_, k_ice_, k_diffuse_;
   ParticleStore::Field shift_ = 0, enthalpy_ = 0;
   cl::Buffer sub_, fluid_, law_;

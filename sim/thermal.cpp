@@ -105,32 +105,9 @@ double liquid_fraction_at(const MaterialThermal& m, double h, double shift) {
 
 std::vector<double> melt_shifts_of(const HostParticles& p, const Scene& scene) {
   std::vector<double> out;
-  if (!substances_lower_melting(scene)) return out;
-  out.assign(p.size(), 0.0);
-  if (const HostColumn* c = p.column(kMeltShiftField); c && c->size() == p.size()) {
-    for (std::size_t i = 0; i < p.size(); ++i) out[i] = double(c->as<float>()[i]);
-    return out;
-  }
-  // As substance.cl's substance_state: K_f sum_s i_s Q_s / M_s over the mass of the water, m - sum_s Q_s.
-  std::vector<const Float2*> amounts;
-  for (const Substance& s : scene.substances) {
-    const HostColumn* c = p.column(substance_field(s.name).name);
-    amounts.push_back(c && c->size() == p.size() ? c->as<Float2>() : nullptr);
-  }
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const Material& m = scene.materials[p.material[i]];
-    if (p.phase[i] != std::uint8_t(Phase::Water) || m.kind != MaterialKind::Fluid) continue;
-    double dissolved = 0, particles = 0;
-    for (std::size_t k = 0; k < amounts.size(); ++k) {
-      if (!amounts[k]) continue;
-      const double q = double(amounts[k][i][0]) + double(amounts[k][i][1]);
-      dissolved += q;
-      const Substance& s = scene.substances[k];
-      if (s.lowers_melting_point()) particles += s.dissociation * q / s.molar_mass;
-    }
-    const double water = double(p.position[i][3]) - dissolved;
-    out[i] = water > 0 ? std::min(m.cryoscopic_constant * particles / water, kMaxMeltingPointDrop) : 0.0;
-  }
+  const HostColumn* c = p.column(kMeltShiftField);
+  if (!substances_lower_melting(scene) || !c || c->size() != p.size()) return out;
+  out.assign(c->as<float>(), c->as<float>() + p.size());
   return out;
 }
 

@@ -32,9 +32,8 @@ double temperature_at(const MaterialThermal& m, double enthalpy, double shift = 
 double liquid_fraction_at(const MaterialThermal& m, double enthalpy, double shift = 0.0);
 
 // How far below its material's melting point each particle melts [K] where the scene's substances lower it
-// (docs/SUBSTANCES.md): the substance stage's "melt_shift" column where the particles carry one (a running
-// solver's), else each water particle's from the substances it holds and 0 for ice (a state file, which does
-// not keep the shift: ice in brine then reads its own melting point). Empty where nothing lowers it.
+// (docs/SUBSTANCES.md): the particles' "melt_shift" column, which sampled scenes, solvers and state files
+// carry; empty where nothing lowers it or the particles carry no such column.
 std::vector<double> melt_shifts_of(const HostParticles& p, const Scene& scene);
 
 // Temperatures [°C] of a particle set (e.g. read from a state file), one per particle, with their melt

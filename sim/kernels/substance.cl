@@ -1,15 +1,15 @@
 /* Substances dissolved in the water (issue 20, docs/SUBSTANCES.md): each water particle holds an amount
  * Q_i [kg] of each of up to four substances (THAW_NSUB), carried with it by the flow; between water
  * particles it diffuses by Fick's law, rho Dw/Dt = div(rho D grad w) for the mass fraction w = Q / m. Built
- * with sph_kernel.h, grid_common.h, sph_lanes.h, wrapped_walk.h and substance_params.h.
+ * with sph_kernel.h, grid_common.h, sph_lanes.h, wrapped_walk.h, thermal_law.h and substance_params.h.
  *
  * The pair term is Cleary & Monaghan's (1999, eq. 9; Brookshaw 1985), the form the heat pass conducts by
- * (heat.cl) and Orthmann et al. 2013 sec. 5 carry their bulk quantities with, with w in place of T and the
- * harmonic mean of rho D in place of k's:
+ * (heat.cl) and Orthmann et al. 2013 sec. 5 carry their bulk quantities with, with w in place of T and
+ * rho D in place of k:
  *   dQ_i/dt = sum_j 2 V_i V_j K_ij (w_i - w_j) (x_ij . grad W_ij) / (r_ij^2 + eta^2),
  *   K_ij = D sqrt(rho_i rho_j),  so  V_i V_j K_ij = D m_i m_j / sqrt(rho_i rho_j) = D a_i a_j,  a = m / sqrt(rho):
  * the geometric mean of rho D, where the conduction pass takes the harmonic mean of k. Within one liquid the
- * densities differ by a percent at most, where the means agree to 1e-4; a product of per-particle numbers is
+ * densities differ by a percent at most, where the means agree to 1e-5; a product of per-particle numbers is
  * symmetric without a division in the pair loop: with the harmonic form the pass took 1.38 times the density
  * pass's time on 97k particles (bench/scenes/block.json, one substance), with this one 1.18-1.20 times.
  * Mass fractions rather than concentrations per volume: a uniform solution has no gradient of w where the
@@ -83,14 +83,6 @@ float2 lanes_compensated(floatV hi, floatV lo) {
     (hi) = t_;                                 \
   }
 
-/* M, A and w of every particle, and each water particle's melt shift from the substances it holds:
- * K_f sum_s i_s Q_s / M_s over the mass of its water, m - sum_s Q_s (capped at max_shift). `fluid` holds each
- * material's rest density and cryoscopic constant. With the ice pass (THAW_MELT_SHIFT or THAW_REJECT), ice
- * that is partly melted at its lowered melting point carries substances too, in its melted part: M is that
- * part's mass, its liquid fraction (from its enthalpy and last step's shift; `law` holds each material's
- * L, c_solid, c_liquid and physical over SPH mass) times its physical mass. The melt in a partly melted
- * particle then mixes with the brine around it, so the brine dilutes as ice melts into it: with the melt
- * kept fresh, brine-melting's column stayed at the undiluted brine's liquidus. */
 /* The melt shift d [K] that the solutes in a particle's melted part give it, consistent with that part:
  * d = K_f n / (f(h, d) m - Q), with f the lowered law's liquid fraction at the particle's enthalpy h
  * (thermal_law.h), Kn = K_f n (n the moles of dissolved particles), Q the kg dissolved and m the physical
@@ -121,6 +113,14 @@ float2 solutes(global const float2* q[4], const uint i, const SubstanceParams P)
   return held;
 }
 
+/* M, A and w of every particle. With THAW_MELT_SHIFT, each water particle's melt shift, the molality of its
+ * liquid part (own_shift); `fluid` holds each material's rest density and cryoscopic constant. With the ice
+ * pass (THAW_MELT_SHIFT or THAW_REJECT), ice that is partly melted at its lowered melting point carries
+ * substances too, in its melted part: M is that part's mass, its liquid fraction (from its enthalpy and last
+ * step's shift; `law` holds each material's L, c_solid, c_liquid and physical over SPH mass) times its
+ * physical mass. The melt in a partly melted particle then mixes with the brine around it, so the brine
+ * dilutes as ice melts into it: with the melt kept fresh, brine-melting's column stayed at the undiluted
+ * brine's liquidus. `shift` is the melt_shift field with THAW_MELT_SHIFT, untouched otherwise. */
 kernel void substance_state(global const float4* pos, global const float* density, global const float2* enthalpy,
                             global const uchar* phase, global const uchar* material, global const float2* fluid,
                             global const float4* law, global float* sub, global float* shift,
@@ -153,12 +153,16 @@ kernel void substance_state(global const float4* pos, global const float* densit
   }
 #endif
   /* Ice partly melted carries what its melt holds, at last step's shift (the ice pass renews it). */
-  if (phase[i] == THAW_PHASE_ICE && m > 0.0f && l.x > 0.0f)
-    carried = thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, shift[i]) * m * l.w;
+#ifdef THAW_MELT_SHIFT
+  const float ice_shift = shift[i];
+#else
+  const float ice_shift = 0.0f;
 #endif
+  if (phase[i] == THAW_PHASE_ICE && m > 0.0f && l.x > 0.0f)
+    carried = thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, ice_shift) * m * l.w;
+#endif
+#ifdef THAW_MELT_SHIFT
   if (!water && phase[i] != THAW_PHASE_ICE) shift[i] = 0.0f;
-#ifndef THAW_MELT_SHIFT
-  if (water) shift[i] = 0.0f;
 #endif
   const float rho = water && P.flow ? density[i] : f.x;
   sub[SUB_M * stride + i] = carried;
@@ -202,17 +206,20 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
       const intV water =
           carrier & (THAW_CAT(convert_int, THAW_VW)(THAW_CAT(vload, THAW_VW)(0, phase + j)) == THAW_PHASE_WATER);
       const floatV wsh = w_shape(sqrt(r2) * inv_H);
-      const floatV w = select((floatV)(0.0f), wsh, carrier);
+      sw += select((floatV)(0.0f), wsh, carrier);
+#ifdef THAW_MELT_SHIFT
       const floatV ww = select((floatV)(0.0f), wsh, water);
-      sw += w;
       sww += ww;
       sd += ww * select((floatV)(0.0f), vloadV(0, shift + j), water);
+#endif
     }
   }
-  /* The same order of additions as the weights substance_diffuse gives out (lanes, then over them). */
-  const float weight = lanes_compensated(sw, (floatV)(0.0f)).x, water_weight = lanes_sum(sww);
-  const float around = water_weight > 0.0f ? lanes_sum(sd) / water_weight : 0.0f;
+  /* What it gives each carrier is its amount / weight times their pair's weight; the split closes to
+   * round-off whatever order weight was summed in, since giver and taker compute the same products. */
+  const float weight = lanes_sum(sw);
 #ifdef THAW_MELT_SHIFT
+  const float water_weight = lanes_sum(sww);
+  const float around = water_weight > 0.0f ? lanes_sum(sd) / water_weight : 0.0f;
   /* Or its own, where it holds what lowers it (salt dropped on dry ice): the molality of its melted part, the
    * cap while it has none, so it melts until its melt holds the salt as brine at its own liquidus. `fluid`
    * gives ice the cryoscopic constant of the water it melts into. */
@@ -222,8 +229,6 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
   const float2 e = enthalpy[i];
   const float own = own_shift(e.x + e.y, l, pi.w * l.w, held.x, fluid[material[i]].y * held.y, P.max_shift);
   shift[i] = fmax(around, own);
-#else
-  shift[i] = around;
 #endif
 #ifdef THAW_REJECT
   /* Ice partly melted carries what its melt holds (substance_state gave it its w); frozen through, it gives it
@@ -278,11 +283,10 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
       PAIR_LANES(pi, j, period)
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
       const floatV mj = vloadV(0, M + j);
+      const floatV qr = sqrt(r2) * inv_H;
       if (!giving) {
         /* Symmetric in i and j operand by operand (the header); 0 for lanes out of range or not water. */
-        const floatV pair = select((floatV)(0.0f),
-                                   (ai * vloadV(0, A + j)) *
-                                       (grad_shape(sqrt(r2) * inv_H) * r2 / (r2 + eta2)),
+        const floatV pair = select((floatV)(0.0f), (ai * vloadV(0, A + j)) * (grad_shape(qr) * r2 / (r2 + eta2)),
                                    in & (mj > 0.0f));
         for (int s = 0; s < THAW_NSUB; ++s) {
           const floatV d = pair * ((wi[s] - vloadV(0, sub + (SUB_W + s) * stride + j)) * c[s]);
@@ -293,10 +297,13 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
       /* Ice gives to water: the giver's amount per weight times the pair's weight, computed alike on both
        * sides. */
       const intV handed = in & (giving ? (mj > 0.0f) : (mj < 0.0f));
-      const floatV w = select((floatV)(0.0f), w_shape(sqrt(r2) * inv_H), handed);
-      for (int s = 0; s < THAW_NSUB; ++s) {
-        const floatV d = giving ? -(wi[s] * w) : vloadV(0, sub + (SUB_W + s) * stride + j) * w;
-        ACCUMULATE(hi[s], lo[s], d)
+      /* Givers are rare (water froze through last step): most water skips this for every candidate. */
+      if (any(handed)) {
+        const floatV w = select((floatV)(0.0f), w_shape(qr), handed);
+        for (int s = 0; s < THAW_NSUB; ++s) {
+          const floatV d = giving ? -(wi[s] * w) : vloadV(0, sub + (SUB_W + s) * stride + j) * w;
+          ACCUMULATE(hi[s], lo[s], d)
+        }
       }
 #endif
     }
