@@ -15,7 +15,7 @@ OUT=${2:-gpu-check}
 THAW="$BUILD/thaw"
 # GPU_CHECK_STEPS: the steps to run (default: all); GPU_CHECK_TESTS: the tests' gtest filter;
 # GPU_CHECK_TEST_SECONDS: their time limit (default 240; on an H200 they took about 3 minutes).
-STEPS=" ${GPU_CHECK_STEPS:-info build-log throughput throughput-32tiles throughput-512tiles dam-1M-wcsph dam-1M-dfsph scene-default scene-ice-bunny bodies render-bench render-png tests} "
+STEPS=" ${GPU_CHECK_STEPS:-info build-log throughput throughput-32tiles throughput-512tiles dam-1M-wcsph dam-1M-dfsph scene-default scene-ice-bunny substances-100k substances-1M bodies render-bench render-png tests} "
 mkdir -p "$OUT"
 LOG="$OUT/gpu-check.log"
 : >"$LOG"
@@ -45,6 +45,28 @@ done
 # Melting scenes with free ice, heat and a dryer (the service's default scene), and the ice bodies' passes.
 step scene-default 60 "$THAW" run default --until 0.5 --no-progress --frames "$OUT/frames" --every 2000
 step scene-ice-bunny 60 "$THAW" run ice-bunny --until 0.5 --no-progress
+# The substance stage's cost on the benchmark block (docs/SUBSTANCES.md): none, one and three bulk substances,
+# and a surface-active one beside two bulk ones, at 97k and 1M particles.
+substance_runs() {
+  local size=$1 spacing=$2
+  local bulk='"salt": {"diffusivity": 1.5e-9, "molar_mass": 0.05844, "dissociation": 2}, "sugar": {"diffusivity": 5e-10}'
+  local soap='"soap": {"kind": "surface_active", "diffusivity": 1e-9}'
+  for set in '' '{"dye": {"diffusivity": 1e-9}}' "{\"dye\": {\"diffusivity\": 1e-9}, $bulk}" \
+    "{\"dye\": {\"diffusivity\": 1e-9}, $soap}" "{\"dye\": {\"diffusivity\": 1e-9}, $bulk, $soap}"; do
+    local args=(--set "spacing=$spacing")
+    if [ -n "$set" ]; then
+      local conc
+      conc=$(echo "$set" | grep -o '"[a-z]*": {"' | sed 's/: {"//' | sed 's/$/: {"concentration": 1}/' | paste -sd, -)
+      args+=(--set "substances=$set" --set "fluids[0].substances={$conc}")
+    fi
+    echo "== $size particles, substances: ${set:-none}"
+    "$THAW" run bench/scenes/block.json --steps 200 --no-progress "${args[@]}"
+  done
+}
+export -f substance_runs
+export THAW
+step substances-100k 90 bash -c 'substance_runs 97k 0.002'
+step substances-1M 200 bash -c 'substance_runs 1M 0.00092'
 step bodies 40 "$THAW" bench bodies --size 1000000
 step render-bench 40 "$THAW" bench render --sizes 100000,1000000
 if [ -f "$OUT/dam-1M-dfsph.state" ]; then

@@ -106,6 +106,21 @@ std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::
     }
     arrays.push_back(std::move(a));
   }
+  // Surface-active substances on the surface: the surface excess, the amount over the particle's area
+  // [kg/m^2].
+  const HostColumn* area = p.column("surface_area");
+  for (const HostColumn& c : p.columns) {
+    if (c.spec.name.rfind(kAdsorbedPrefix, 0) != 0 || c.spec.width != 2 || c.size() != p.size()) continue;
+    VtkArray a{c.spec.name, "Float32", 1, {}};
+    a.bytes.reserve(4 * n);
+    const Float2* q = c.as<Float2>();
+    for (std::size_t i : order) {
+      const float ai = area && area->size() == p.size() ? area->as<float>()[i] : 0.0f;
+      put_little_endian(a.bytes,
+                        ai > 0.0f ? static_cast<float>((double(q[i][0]) + double(q[i][1])) / ai) : 0.0f);
+    }
+    arrays.push_back(std::move(a));
+  }
   // Every field a stage declared as exported (sim/particle_fields.h), element by element in id order.
   for (const HostColumn& c : p.columns) {
     if (!c.spec.exported || c.size() != p.size()) continue;

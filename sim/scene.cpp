@@ -55,6 +55,7 @@ const char* name(KernelFunction k) {
 const char* name(Eos e) { return e == Eos::Tait ? "tait" : "linear"; }
 const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph" : "wcsph"; }
 const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
+const char* name(SubstanceKind k) { return k == SubstanceKind::SurfaceActive ? "surface_active" : "bulk"; }
 const char* name(ExposedArea a) {
   switch (a) {
     case ExposedArea::Orthmann2013:
@@ -509,6 +510,13 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     sub.molar_mass = d["molar_mass"].get<double>();
     sub.dissociation = d["dissociation"].get<double>();
     sub.enters_ice = d["enters_ice"].get<bool>();
+    sub.kind = choice_of<SubstanceKind>(d["kind"], {SubstanceKind::Bulk, SubstanceKind::SurfaceActive});
+    if (sub.surface_active()) {
+      sub.surface_diffusivity = d["surface_diffusivity"].get<double>();
+      sub.adsorption_rate = d["adsorption_rate"].get<double>();
+      sub.desorption_rate = d["desorption_rate"].get<double>();
+      sub.surface_capacity = d["surface_capacity"].get<double>();
+    }
     s.substances.push_back(sub);
   }
   s.camera = camera_from_json(doc["camera"]);

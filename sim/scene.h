@@ -38,6 +38,7 @@ enum class BoundaryVolume { Lattice, Akinci2012 };
 enum class DfsphBoundary { Adami2012, Akinci2012 };
 // How fluids of several rest densities meet (dfsph, sim/kernels/dfsph.cl).
 enum class Multiphase { HuAdams2006, DomaradzkiMartyn };
+enum class SubstanceKind { Bulk, SurfaceActive };
 enum class ExposedArea { Iwasaki2010, Orthmann2013, Brackbill1992 };
 // Interfacial tension (sim/tension_stage.h): none, Akinci et al. 2013's cohesion, curvature and adhesion, or
 // Iwasaki et al. 2010's eq. 4.
@@ -47,13 +48,14 @@ enum class NoSlip { None, Adami2012 };
 // What a dryer is: an analytic cone of warm air that heats exposed ice and water (scenes without air
 // particles), or a nozzle that blows air particles (scenes with `air`; sim/emitters.h).
 enum class DryerModel { Cone, Air };
-const char* name(MaterialKind k);    // "fluid", "solid", "ice", "air"
+const char* name(MaterialKind k);  // "fluid", "solid", "ice", "air"
 // Whether particles of this kind move with the fluid passes and carry their own mass (fluid and air).
 inline bool flows(MaterialKind k) { return k == MaterialKind::Fluid || k == MaterialKind::Air; }
 const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
 const char* name(Eos e);             // "tait", "linear"
 const char* name(PressureSolver p);  // "wcsph", "dfsph"
 const char* name(BoundaryVolume b);  // "lattice", "akinci"
+const char* name(SubstanceKind k);   // "bulk", "surface_active"
 const char* name(ExposedArea a);     // "iwasaki2010", "orthmann2013", "brackbill1992"
 const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
 const char* name(Multiphase m);      // "hu_adams2006", "domaradzki_martyn"
@@ -71,10 +73,10 @@ struct Material {
   double latent_heat = 0.0;    // L [J/kg] of an ice and the fluid it melts into; 0 otherwise
   double melting_point = 0.0;  // T_m [°C] of the same pair
   double cryoscopic_constant =
-      1.86;                    // K_f [K kg/mol] of a fluid: its melting point falls K_f i b (substances)
-  int partner = -1;            // ice: the fluid it melts into; fluid: the ice it freezes into; -1 none
-  bool transparent = false;    // solids: drawn as glass (the renderer's business only)
-  bool adiabatic = false;      // solids: an ideal insulator (heat.cl, adiabatic_state)
+      1.86;                  // K_f [K kg/mol] of a fluid: its melting point falls K_f i b (substances)
+  int partner = -1;          // ice: the fluid it melts into; fluid: the ice it freezes into; -1 none
+  bool transparent = false;  // solids: drawn as glass (the renderer's business only)
+  bool adiabatic = false;    // solids: an ideal insulator (heat.cl, adiabatic_state)
   // Variants the scene loader adds (named "<material> (...)"): a solid held at a temperature, and the
   // tank walls when they exchange heat with the outside.
   bool held = false;
@@ -129,6 +131,16 @@ struct Substance {
   double dissociation = 1.0;  // van 't Hoff's factor i: ions per formula unit (NaCl 2)
   bool enters_ice = false;    // false: water that freezes gives it up to the water around it
   bool lowers_melting_point() const { return molar_mass > 0; }
+  // A surface-active substance (Orthmann et al. 2013 sec. 5-6.2) also sits on the water's free surface, an
+  // amount per particle over its surface area (a surface excess Gamma [kg/m^2]), exchanged with the bulk by
+  // Langmuir's kinetics, dGamma/dt = k_a c (1 - Gamma / Gamma_max) - k_d Gamma, and diffusing along the
+  // surface with D_s. A bulk one stays in the bulk.
+  SubstanceKind kind = SubstanceKind::Bulk;
+  double surface_diffusivity = 1e-9;  // D_s [m^2/s]
+  double adsorption_rate = 1e-4;      // k_a [m/s]
+  double desorption_rate = 0.1;       // k_d [1/s]
+  double surface_capacity = 1.2e-6;   // Gamma_max [kg/m^2]; 0: unlimited (Henry's law)
+  bool surface_active() const { return kind == SubstanceKind::SurfaceActive; }
 };
 inline constexpr int kMaxSubstances = 4;  // per scene: the stage walks the neighbours once for all of them
 
@@ -137,7 +149,7 @@ struct FluidBlock {
   Shape shape;       // filled with particles on a lattice of the scene's spacing (a box unless it says)
   Box box;           // the shape's bounding box
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-  double temperature = 20.0;  // initial [°C]
+  double temperature = 20.0;       // initial [°C]
   std::vector<double> substances;  // initial concentration of each of Scene::substances [kg/m^3]
 };
 
@@ -198,8 +210,8 @@ struct Emitter {
   double speed = 0.5;                                     // exit speed [m/s]
   double temperature = 20.0;                              // of the fluid poured [°C]
   std::vector<double> substances;  // each of Scene::substances in what it pours [kg/m^3]; fixed while it runs
-  double start = 0.0;                                     // pours from this time on [s]
-  double stop = 0.0;                                      // and until this time [s]; 0: for ever
+  double start = 0.0;              // pours from this time on [s]
+  double stop = 0.0;               // and until this time [s]; 0: for ever
   // The nozzle's area pi r^2 [m^2] and the volume flow A v [m^3/s] it pours while open.
   double area() const;
   double volume_flow() const { return area() * speed; }

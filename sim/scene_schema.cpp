@@ -431,38 +431,72 @@ const Field& scene_schema() {
                       .client_settable(),
               },
               "Still air around the scene (the mode without air particles)."),
-          map_of("substances", "<name>",
-                 {
-                     number("diffusivity",
-                            "Its molecular diffusivity D in water: about 1e-9 for a dye or a salt at 20 °C "
-                            "(NaCl 1.5e-9), 0 for none")
-                         .in("m^2/s")
-                         .def(1e-9)
-                         .at_least(0)
-                         .at_most(1e-2),
-                     number("molar_mass",
-                            "Its molar mass, which makes it lower the melting point of the water it is "
-                            "dissolved in by the fluid's cryoscopic_constant times dissociation times its "
-                            "molality (Blagden's law with van 't Hoff's factor): NaCl 0.05844. 0: it does "
-                            "not (a dye)")
-                         .in("kg/mol")
-                         .def(0.0)
-                         .at_least(0)
-                         .at_most(100),
-                     number("dissociation",
-                            "van 't Hoff's factor i: the particles one formula unit makes in solution (NaCl "
-                            "2, sugar 1)")
-                         .def(1.0)
-                         .at_least(1)
-                         .at_most(10),
-                     flag("enters_ice",
-                          "Whether water that freezes keeps it; false (salt, dye): the freezing water gives "
-                          "it up to the water around it")
-                         .def(false),
-                 },
-                 "Substances the water carries (docs/SUBSTANCES.md), at most 4: each water particle holds "
-                 "its amount of each, which moves with it and diffuses to the water around it; fluids' "
-                 "`substances` say where they start")
+          map_of(
+              "substances", "<name>",
+              {
+                  number("diffusivity",
+                         "Its molecular diffusivity D in water: about 1e-9 for a dye or a salt at 20 °C "
+                         "(NaCl 1.5e-9), 0 for none")
+                      .in("m^2/s")
+                      .def(1e-9)
+                      .at_least(0)
+                      .at_most(1e-2),
+                  number("molar_mass",
+                         "Its molar mass, which makes it lower the melting point of the water it is "
+                         "dissolved in by the fluid's cryoscopic_constant times dissociation times its "
+                         "molality (Blagden's law with van 't Hoff's factor): NaCl 0.05844. 0: it does "
+                         "not (a dye)")
+                      .in("kg/mol")
+                      .def(0.0)
+                      .at_least(0)
+                      .at_most(100),
+                  number("dissociation",
+                         "van 't Hoff's factor i: the particles one formula unit makes in solution (NaCl "
+                         "2, sugar 1)")
+                      .def(1.0)
+                      .at_least(1)
+                      .at_most(10),
+                  flag("enters_ice",
+                       "Whether water that freezes keeps it; false (salt, dye): the freezing water gives "
+                       "it up to the water around it")
+                      .def(false),
+                  choice("kind", {"bulk", "surface_active"},
+                         "bulk: it stays dissolved in the water; surface_active (a detergent): it also "
+                         "gathers on the water's free surface, adsorbing from and desorbing to the water "
+                         "under it and diffusing along the surface (Orthmann et al. 2013 sec. 5-6.2)")
+                      .def("bulk"),
+                  number("surface_diffusivity", "Its diffusivity D_s along the free surface")
+                      .in("m^2/s")
+                      .def(1e-9)
+                      .at_least(0)
+                      .at_most(1e-2)
+                      .when("kind", "surface_active"),
+                  number("adsorption_rate",
+                         "k_a in Langmuir's dGamma/dt = k_a c (1 - Gamma / Gamma_max) - k_d Gamma: the "
+                         "speed at which the surface takes it from the water under it")
+                      .in("m/s")
+                      .def(1e-4)
+                      .at_least(0)
+                      .at_most(1)
+                      .when("kind", "surface_active"),
+                  number("desorption_rate", "k_d: the rate at which the surface gives it back to the water")
+                      .in("1/s")
+                      .def(0.1)
+                      .at_least(0)
+                      .at_most(1e4)
+                      .when("kind", "surface_active"),
+                  number("surface_capacity",
+                         "Gamma_max, the most the surface holds per area (a detergent such as SDS: about "
+                         "1.2e-6); 0: no limit (Henry's law)")
+                      .in("kg/m^2")
+                      .def(1.2e-6)
+                      .at_least(0)
+                      .at_most(1)
+                      .when("kind", "surface_active"),
+              },
+              "Substances the water carries (docs/SUBSTANCES.md), at most 4: each water particle holds "
+              "its amount of each, which moves with it and diffuses to the water around it; fluids' "
+              "`substances` say where they start")
               .def(Json::object()),
           map_of("materials", "<name>",
                  {

@@ -144,8 +144,8 @@ SolverConstants derive_constants(const Scene& scene) {
   // sound speed. DFSPH's steps are as long as the flow allows, and symplectic Euler needs omega dt < 2:
   // there the spring stiffens only enough to stop the fastest expected flow within a third of a spacing,
   // c_push = 3 v_ref (omega dt = 0.66 at the default max_dt in a 25 cm column).
-  const double c_push =
-      s.pressure == PressureSolver::Dfsph ? std::min(double(k.sound_speed), 3.0 * v_ref) : double(k.sound_speed);
+  const double c_push = s.pressure == PressureSolver::Dfsph ? std::min(double(k.sound_speed), 3.0 * v_ref)
+                                                            : double(k.sound_speed);
   k.repulsion = static_cast<float>(c_push * c_push / (dx * dx * k.rest_density * dx * dx * dx));
   k.repulsion_range = static_cast<float>(0.95 * dx);
   k.repulsion_damping = static_cast<float>(dx / c_push);
@@ -375,14 +375,17 @@ void Solver::build(const SimState& st, std::size_t capacity) {
                          : cl::Buffer();
   if (plan.build)
     heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
-  if (heat_ && heat_->uses_surface()) {
+  // The surface's areas where heat exchanges through them or surface-active substances sit on them.
+  if ((heat_ && heat_->uses_surface()) || substances_need_surface(scene_))
     surface_ = std::make_unique<SurfaceStage>(cl_, store_, f_, scene_, k_, opts, layout_);
-    heat_->surface_from(surface_->area());
-  }
+  if (heat_ && heat_->uses_surface()) heat_->surface_from(surface_->area());
   if (!scene_.substances.empty()) {
     const ParticleStore::Field enthalpy = heat_ ? heat_->enthalpy() : 0;
-    substances_ = std::make_unique<SubstanceStage>(cl_, store_, f_, scene_, k_, opts, layout_,
-                                                   heat_ ? &enthalpy : nullptr);
+    const SurfaceFields surface =
+        surface_ ? SurfaceFields{surface_->area(), surface_->normal()} : SurfaceFields{};
+    substances_ =
+        std::make_unique<SubstanceStage>(cl_, store_, f_, scene_, k_, opts, layout_,
+                                         heat_ ? &enthalpy : nullptr, surface_ ? &surface : nullptr);
   }
   if (substances_ && substances_->lowers_melting()) heat_->melt_shift_from(substances_->melt_shift());
   if (fluid_ && heat_) fluid_->buoyancy_from(heat_->enthalpy());
@@ -479,11 +482,11 @@ void Solver::remove_particles_from(std::size_t kept) {
   // Substances that left with the water, booked before the particles go.
   if (substances_) {
     std::vector<Float2> amount(gone);
-    for (std::size_t s = 0; s < substances_->fields().size(); ++s) {
-      q.enqueueReadBuffer(store_[substances_->fields()[s]], CL_TRUE, kept * sizeof(Float2),
-                          gone * sizeof(Float2), amount.data());
-      for (const Float2& a : amount) substance_books_.outflow[s] += double(a[0]) + double(a[1]);
-    }
+    for (std::size_t s = 0; s < substances_->fields().size(); ++s)
+      for (const ParticleStore::Field f : substances_->amount_fields(s)) {
+        q.enqueueReadBuffer(store_[f], CL_TRUE, kept * sizeof(Float2), gone * sizeof(Float2), amount.data());
+        for (const Float2& a : amount) substance_books_.outflow[s] += double(a[0]) + double(a[1]);
+      }
   }
   for (std::size_t k = 0; k < gone; ++k) {
     if (!heat_) h[k] = fixed_enthalpy_[id[k]];
@@ -671,8 +674,7 @@ void Solver::trace_photons(double dt) {
 
 NeighbourView Solver::neighbours() const { return grid_->view(); }
 
-void Solver::heat_stages(double dt) {
-  timed(Stage::Photons, [&] { trace_photons(dt); });
+void Solver::update_surface() {
   // Without flow the particles never move: the first pass's areas serve the whole run. With flow they are
   // updated every heat.area_interval steps (counted from step 0, so a resumed run updates when the straight
   // one did).
@@ -681,6 +683,10 @@ void Solver::heat_stages(double dt) {
     timed(Stage::Surface, [&] { surface_->run(neighbours()); });
     surface_done_ = true;
   }
+}
+
+void Solver::heat_stages(double dt) {
+  timed(Stage::Photons, [&] { trace_photons(dt); });
   timed(Stage::Heat, [&] { compute_heat(dt); });
 }
 
@@ -731,6 +737,7 @@ void Solver::step() {
   if (rigid_) timed(Stage::IceForces, [&] { rigid_->compute_forces(buffers()); });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
+  update_surface();
   if (substances_) timed(Stage::Substances, [&] { substances_->prepare(neighbours()); });
   if (heat_) heat_stages(dt);
   if (substances_) timed(Stage::Substances, [&] { substances_->diffuse(dt, neighbours()); });
@@ -765,6 +772,7 @@ void Solver::step_dfsph() {
   if (tension_) timed(Stage::Tension, [&] { tension_->run(neighbours(), fluid_->accel()); });
   double dt = 0;
   timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
+  update_surface();
   if (substances_) timed(Stage::Substances, [&] { substances_->prepare(neighbours()); });
   if (heat_) heat_stages(dt);
   if (substances_) timed(Stage::Substances, [&] { substances_->diffuse(dt, neighbours()); });
@@ -880,7 +888,7 @@ std::vector<std::string> Solver::stages() const {
   if (heat_ && heat_->tracing_photons()) out.push_back("photons");
   if (heat_ && !heat_->tracing_photons() && !scene_.lamps.empty())
     out.push_back("photons (when a lamp is on)");
-  if (surface_) out.push_back(std::string("surface (") + name(scene_.heat.exposed_area) + ")");
+  if (surface_) out.push_back(std::string("surface (") + name(surface_->model()) + ")");
   if (heat_) out.push_back("heat (" + heat_reason_ + ")");
   if (substances_) out.push_back("substances (" + std::to_string(scene_.substances.size()) + ")");
   if (fluid_) out.push_back("integrate");

@@ -171,6 +171,7 @@ class Solver {
   double choose_time_step();
   void trace_photons(double dt);  // lamps: photons absorbed this step, as energy per particle
   void compute_heat(double dt);   // conduction, sources, enthalpy update, phase change, budget
+  void update_surface();          // the surface stage's areas, when they are due (heat.area_interval)
   void heat_stages(double dt);    // photons, the surface's areas where heat reads them, then heat, each timed
   void integrate(double dt);
   // Rigid ice only (no-ops otherwise): label the ice into bodies now, and the ice-force pass; the force
@@ -198,7 +199,7 @@ class Solver {
   // Each particle's surface area [m^2] from the surface stage (sim/surface_stage.h), as the last step left
   // it; empty when the scene does not build that stage.
   std::vector<float> surface_areas() const;
-  std::vector<float> temperatures() const;     // per particle [°C], from the last heat stage's state
+  std::vector<float> temperatures() const;  // per particle [°C], from the last heat stage's state
   // The heat stage's inputs as its neighbour loop reads them (for reference loops and tests): T [°C],
   // k [W/m/K] and V [m^3] per particle, from the last compute_heat(); empty without heat.
   struct ThermalInputs {
@@ -257,8 +258,8 @@ class Solver {
   // never changes and stays on the host, by particle id (fixed_enthalpy_). The budget is the run's
   // whatever is built; the thermal table gives the masses its enthalpy sum needs.
   std::unique_ptr<HeatStage> heat_;
-  std::unique_ptr<SurfaceStage> surface_;  // only when heat_ takes its exposed areas from it
-  std::unique_ptr<TensionStage> tension_;  // only with flow and tension.model other than none
+  std::unique_ptr<SurfaceStage> surface_;       // only when heat_ takes its exposed areas from it
+  std::unique_ptr<TensionStage> tension_;       // only with flow and tension.model other than none
   std::unique_ptr<SubstanceStage> substances_;  // only where the scene declares substances
   SubstanceBooks substance_books_;
   bool surface_done_ = false;  // the areas are there: computed in this run, or brought by its state

@@ -1,6 +1,7 @@
 #include "sim/substance_stage.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "sim/cl_launch.h"
@@ -14,6 +15,15 @@ FieldSpec substance_field(const std::string& name) {
 }
 
 FieldSpec melt_shift_field() { return {kMeltShiftField, FieldType::Float32, 1, true, true}; }
+
+FieldSpec adsorbed_field(const std::string& name) {
+  return {kAdsorbedPrefix + name, FieldType::Float32, 2, true, false};
+}
+
+bool substances_need_surface(const Scene& scene) {
+  return std::any_of(scene.substances.begin(), scene.substances.end(),
+                     [](const Substance& s) { return s.surface_active(); });
+}
 
 void add_substance_columns(HostParticles& p, const Scene& scene, const std::vector<std::size_t>& first_of,
                            const std::vector<std::vector<double>>& concentrations) {
@@ -68,12 +78,20 @@ bool substances_rejected_by_ice(const Scene& scene) {
 
 SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core,
                                const Scene& scene, const SolverConstants& k, const std::string& build_options,
-                               const ParticleLayout& layout, const ParticleStore::Field* enthalpy)
+                               const ParticleLayout& layout, const ParticleStore::Field* enthalpy,
+                               const SurfaceFields* surface)
     : cl_(cl), store_(store), core_(core), scene_(scene), layout_(layout) {
   for (const Substance& s : scene.substances) {
     fields_.push_back(store.add(substance_field(s.name)));
     diffusivity_.push_back(s.diffusivity);
+    adsorbed_.push_back(-1);
+    if (s.surface_active() && surface) {
+      adsorbed_.back() = static_cast<int>(adsorbed_fields_.size());
+      adsorbed_fields_.push_back(store.add(adsorbed_field(s.name)));
+    }
   }
+  surface_ = !adsorbed_fields_.empty();
+  if (surface_) surface_fields_ = *surface;
   // The shift is a field wherever the scene's substances lower the melting point (a state file keeps it for
   // the temperatures it shows), and renewed here only where heat reads it.
   has_shift_ = substances_lower_melting(scene);
@@ -83,6 +101,7 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   std::string opts = build_options + " -DTHAW_NSUB=" + std::to_string(scene.substances.size());
   if (lowers_) opts += " -DTHAW_MELT_SHIFT";
   if (rejects) opts += " -DTHAW_REJECT";
+  if (surface_) opts += " -DTHAW_SURFACE";
   ice_pass_ = lowers_ || rejects;
   if (enthalpy) enthalpy_ = *enthalpy;
   for (int a = 0; a < 3; ++a)
@@ -94,9 +113,13 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   k_state_ = cl::Kernel(program, "substance_state");
   if (ice_pass_) k_ice_ = cl::Kernel(program, "substance_ice");
   k_diffuse_ = cl::Kernel(program, "substance_diffuse");
+  if (surface_) k_norm_ = cl::Kernel(program, "substance_norm");
 
-  // Zeros past the particles too: the walk's lanes read a few floats beyond each cell's last one.
-  const std::size_t bytes = std::size_t(layout.stride) * (2 + scene.substances.size()) * 4;
+  // Zeros past the particles too: the walk's lanes read a few floats beyond each cell's last one. The
+  // blocks: M, A, W per substance; with surface-active ones AS, NRM, MOM, PX, PY, PZ, NX, NY, NZ, G per
+  // substance.
+  const std::size_t count = scene.substances.size();
+  const std::size_t bytes = std::size_t(layout.stride) * (2 + count + (surface_ ? 9 + count : 0)) * 4;
   sub_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, bytes);
   cl.queue().enqueueFillBuffer(sub_, 0.0f, 0, bytes);
   // Each material's rest density and cryoscopic constant (ice: that of the water it melts into).
@@ -134,10 +157,55 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   const double D = diffusivity_.empty() ? 0.0 : *std::max_element(diffusivity_.begin(), diffusivity_.end());
   const double h = k.smoothing;
   max_dt_ = D > 0 ? scene.solver.diffusion_number * h * h / D : std::numeric_limits<double>::infinity();
+
+  if (!surface_) return;
+  // Surface particles: more than a twentieth of a lattice face of area (kSurfaceMinArea; brackbill1992 gates
+  // the area to the outer layer, where a flat face's particles carry 0.6 of theirs). The surface point of
+  // each lies half a spacing out along its normal: a body sampled on a lattice ends half a spacing past its
+  // outer particles.
+  const double dx = scene.spacing;
+  params_.min_area = static_cast<float>(kSurfaceMinArea * dx * dx);
+  params_.surface_depth = static_cast<float>(surface_depth_spacings * dx);
+  // The 2-D kernel's normalisation over the support H: Wendland C2 7 / (pi H^2), the cubic spline
+  // 40 / (7 pi H^2) (the 3-D ones' shapes, sph_lanes.h).
+  const double H = k.support;
+  const double sigma2 = scene.solver.kernel == KernelFunction::WendlandC2 ? 7.0 / M_PI : 40.0 / (7.0 * M_PI);
+  params_.sigma2 = static_cast<float>(sigma2);
+  sigma2_over_h2_ = sigma2 / (H * H * H * H);
+  rest_density_ = k.rest_density;
+  for (std::size_t s = 0; s < count; ++s) {
+    const Substance& sub = scene.substances[s];
+    if (adsorbed_[s] < 0) continue;
+    params_.surface |= 1u << s;
+    // The most water a step may hand the surface or take back, as a fraction: k_d dt, k_a dt / dx (a
+    // carrier of volume dx^3 under a face dx^2), and the Langmuir saturation rate k_a c / Gamma_max at the
+    // largest concentration the scene starts with or pours, each at most diffusion_number.
+    double c_max = 0;
+    for (const FluidBlock& f : scene.fluids)
+      c_max = std::max(c_max, s < f.substances.size() ? f.substances[s] : 0.0);
+    for (const Emitter& e : scene.emitters)
+      c_max = std::max(c_max, s < e.substances.size() ? e.substances[s] : 0.0);
+    const double rate = sub.desorption_rate + sub.adsorption_rate / dx +
+                        (sub.surface_capacity > 0 ? sub.adsorption_rate * c_max / sub.surface_capacity : 0.0);
+    if (rate > 0) max_dt_ = std::min(max_dt_, scene.solver.diffusion_number / rate);
+    if (sub.surface_diffusivity > 0)
+      max_dt_ = std::min(max_dt_, scene.solver.diffusion_number * h * h / sub.surface_diffusivity);
+  }
 }
 
 const cl::Buffer& SubstanceStage::amount(std::size_t s) const {
   return store_[fields_[std::min(s, fields_.size() - 1)]];
+}
+
+const cl::Buffer& SubstanceStage::on_surface(std::size_t s) const {
+  if (s < adsorbed_.size() && adsorbed_[s] >= 0) return store_[adsorbed_fields_[std::size_t(adsorbed_[s])]];
+  return adsorbed_fields_.empty() ? sub_ : store_[adsorbed_fields_.front()];
+}
+
+std::vector<ParticleStore::Field> SubstanceStage::amount_fields(std::size_t s) const {
+  std::vector<ParticleStore::Field> out{fields_[s]};
+  if (adsorbed_[s] >= 0) out.push_back(adsorbed_fields_[std::size_t(adsorbed_[s])]);
+  return out;
 }
 
 void SubstanceStage::prepare(const NeighbourView& nv) {
@@ -150,12 +218,20 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
   // fills those arguments.
   const cl::Buffer& enthalpy = ice_pass_ ? store_[enthalpy_] : sub_;
   const cl::Buffer& shift = has_shift_ ? store_[shift_] : sub_;
+  const cl::Buffer& area = surface_ ? store_[surface_fields_.area] : sub_;
+  const cl::Buffer& normal = surface_ ? store_[surface_fields_.normal] : sub_;
   set_args(k_state_, store_[core_.position], store_[core_.density], enthalpy, store_[core_.phase],
-           store_[core_.material], fluid_, law_, sub_, shift, amount(0), amount(1), amount(2), amount(3), params_);
+           store_[core_.material], fluid_, law_, sub_, shift, amount(0), amount(1), amount(2), amount(3),
+           area, normal, on_surface(0), on_surface(1), on_surface(2), on_surface(3), params_);
   launch(q, k_state_, layout_.n);
+  if (surface_) {
+    set_args(k_norm_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_);
+    launch(q, k_norm_, layout_.n);
+  }
   if (ice_pass_) {
-    set_args(k_ice_, store_[core_.position], store_[core_.phase], store_[core_.material], fluid_, law_, enthalpy,
-             nv.soa, sub_, shift, nv.cell_start, nv.grid, amount(0), amount(1), amount(2), amount(3), params_);
+    set_args(k_ice_, store_[core_.position], store_[core_.phase], store_[core_.material], fluid_, law_,
+             enthalpy, nv.soa, sub_, shift, nv.cell_start, nv.grid, amount(0), amount(1), amount(2),
+             amount(3), params_);
     launch(q, k_ice_, layout_.n);
   }
 }
@@ -167,8 +243,23 @@ void SubstanceStage::diffuse(double dt, const NeighbourView& nv) {
   float* step[4] = {&params_.step0, &params_.step1, &params_.step2, &params_.step3};
   for (std::size_t s = 0; s < 4; ++s)
     *step[s] = s < diffusivity_.size() ? static_cast<float>(2.0 * diffusivity_[s] * dt) : 0.0f;
+  if (surface_) {
+    float* adsorb[4] = {&params_.adsorb0, &params_.adsorb1, &params_.adsorb2, &params_.adsorb3};
+    float* desorb[4] = {&params_.desorb0, &params_.desorb1, &params_.desorb2, &params_.desorb3};
+    float* inv_capacity[4] = {&params_.inv_capacity0, &params_.inv_capacity1, &params_.inv_capacity2,
+                              &params_.inv_capacity3};
+    float* glide[4] = {&params_.glide0, &params_.glide1, &params_.glide2, &params_.glide3};
+    for (std::size_t s = 0; s < adsorbed_.size(); ++s) {
+      if (adsorbed_[s] < 0) continue;
+      const Substance& sub = scene_.substances[s];
+      *adsorb[s] = static_cast<float>(sub.adsorption_rate * rest_density_ * dt);
+      *desorb[s] = static_cast<float>(sub.desorption_rate * dt);
+      *inv_capacity[s] = sub.surface_capacity > 0 ? static_cast<float>(1.0 / sub.surface_capacity) : 0.0f;
+      *glide[s] = static_cast<float>(2.0 * sub.surface_diffusivity * dt * sigma2_over_h2_);
+    }
+  }
   set_args(k_diffuse_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_, amount(0),
-           amount(1), amount(2), amount(3));
+           amount(1), amount(2), amount(3), on_surface(0), on_surface(1), on_surface(2), on_surface(3));
   launch(cl_.queue(), k_diffuse_, layout_.n);
 }
 
@@ -183,10 +274,11 @@ std::vector<double> SubstanceStage::totals() const {
   const std::size_t n = layout_.n;
   if (n == 0) return out;
   std::vector<Float2> a(n);
-  for (std::size_t s = 0; s < fields_.size(); ++s) {
-    cl_.queue().enqueueReadBuffer(store_[fields_[s]], CL_TRUE, 0, n * sizeof(Float2), a.data());
-    for (const Float2& v : a) out[s] += double(v[0]) + double(v[1]);
-  }
+  for (std::size_t s = 0; s < fields_.size(); ++s)
+    for (const ParticleStore::Field f : amount_fields(s)) {
+      cl_.queue().enqueueReadBuffer(store_[f], CL_TRUE, 0, n * sizeof(Float2), a.data());
+      for (const Float2& v : a) out[s] += double(v[0]) + double(v[1]);
+    }
   return out;
 }
 

@@ -26,6 +26,22 @@ inline constexpr const char* kMeltShiftField = "melt_shift";
 // The field of each particle's melt shift [K] where the scene's substances lower the melting point
 // (substances_lower_melting): saved, so partly melted ice resumes from its last shift, and exported.
 FieldSpec melt_shift_field();
+// The field of each particle's amount of surface-active substance `name` on the free surface [kg] (two
+// floats, hi + lo), saved; the VTU export shows it as the surface excess, amount over the particle's area.
+inline constexpr const char* kAdsorbedPrefix = "adsorbed_";
+FieldSpec adsorbed_field(const std::string& name);
+
+// A water particle with more surface area than this many spacings squared is a surface particle and holds
+// surface-active substances on the surface; one with less hands them to its bulk.
+inline constexpr double kSurfaceMinArea = 0.05;
+// Where a surface particle's point on the surface lies: this many spacings out along its normal.
+inline constexpr double surface_depth_spacings = 0.25;
+// Whether some substance of the scene is surface-active: then the solver builds the surface stage for it.
+bool substances_need_surface(const Scene& scene);
+// The surface stage's fields the substance stage reads.
+struct SurfaceFields {
+  ParticleStore::Field area = 0, normal = 0;
+};
 
 // Whether the scene's substances lower the melting point where it matters: some substance has a molar mass,
 // and some water can melt from or freeze into ice. The heat stage then reads the substance stage's melt
@@ -45,12 +61,17 @@ class SubstanceStage {
  public:
   // `scene` must outlive the stage (the solver's own copy). `enthalpy`: the heat stage's field, null without
   // heat (then nothing melts or freezes, and neither the melt shift nor ice giving substances up is built).
+  // `surface`: the surface stage's area and normal fields, which scenes with surface-active substances
+  // need (substances_need_surface); null otherwise.
   SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
                  const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
-                 const ParticleStore::Field* enthalpy);
+                 const ParticleStore::Field* enthalpy, const SurfaceFields* surface);
 
   // The amount field of each of the scene's substances, in its order.
   const std::vector<ParticleStore::Field>& fields() const { return fields_; }
+  // The fields that hold substance s, which all count to its total: its amount in the bulk, and on the
+  // surface for a surface-active one.
+  std::vector<ParticleStore::Field> amount_fields(std::size_t s) const;
 
   // The diffusion's limit on dt [s]: solver.diffusion_number h^2 / D of the fastest substance.
   double max_dt() const { return max_dt_; }
@@ -86,6 +107,15 @@ class SubstanceStage {
   bool lowers_ = false, has_shift_ = false;  // THAW_MELT_SHIFT is built; the melt_shift field is declared
   cl::Kernel k_state_, k_ice_, k_diffuse_;
   ParticleStore::Field shift_ = 0, enthalpy_ = 0;
+  // Surface-active substances (THAW_SURFACE): their adsorbed fields by substance (-1: none), the surface
+  // stage's fields, and each one's rates [1/s, m/s] for the step's constants.
+  bool surface_ = false;
+  double sigma2_over_h2_ = 0, rest_density_ = 0;
+  std::vector<int> adsorbed_;
+  std::vector<ParticleStore::Field> adsorbed_fields_;
+  SurfaceFields surface_fields_;
+  cl::Kernel k_norm_;
+  const cl::Buffer& on_surface(std::size_t s) const;  // substance s's adsorbed field, or any past the last
   cl::Buffer sub_, fluid_, law_;
   const cl::Buffer& amount(std::size_t s) const;  // substance s's field, or the first's past the last
 };

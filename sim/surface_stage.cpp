@@ -8,6 +8,7 @@
 #include "sim/kernels/sph_kernel.h"
 #include "sim/kernels/surface_params.h"
 #include "sim/solver.h"
+#include "sim/substance_stage.h"
 
 namespace thaw {
 
@@ -30,12 +31,22 @@ std::uint32_t nan_bits() { return std::bit_cast<std::uint32_t>(std::numeric_limi
 SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
                            const SolverConstants& k, const std::string& build_options,
                            const ParticleLayout& layout)
-    : cl_(cl), store_(store), core_(core), scene_(scene), layout_(layout), model_(scene.heat.exposed_area) {
+    : cl_(cl),
+      store_(store),
+      core_(core),
+      scene_(scene),
+      layout_(layout),
+      // heat.exposed_area's model; iwasaki2010 needs no stage, and surface-active substances then take the
+      // default's areas.
+      model_(scene.heat.exposed_area == ExposedArea::Orthmann2013 ? ExposedArea::Orthmann2013
+                                                                  : ExposedArea::Brackbill1992) {
   // Saved where the areas outlive a step (heat.area_interval > 1 in a flowing scene), so a resumed run
   // reads the areas the straight run had.
-  area_ = store.add(
-      {"surface_area", FieldType::Float32, 1, scene.solver.flow && scene.heat.area_interval > 1, true});
-  normal_ = store.add({"surface_normal", FieldType::Float32, 4, false, true});
+  const bool outlive = scene.solver.flow && scene.heat.area_interval > 1;
+  area_ = store.add({"surface_area", FieldType::Float32, 1, outlive, true});
+  // The normals too where surface-active substances read them (their points on the surface).
+  normal_ =
+      store.add({"surface_normal", FieldType::Float32, 4, outlive && substances_need_surface(scene), true});
   // Saved, so a resumed run relaxes from where it stopped; NaN (none yet) where a state has none.
   delta_ = store.add({"surface_delta", FieldType::Float32, 1, true, false, nan_bits()});
 

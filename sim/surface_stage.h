@@ -2,7 +2,8 @@
 // The surface stage: each ice and water particle's share of the surface to the air (or to empty space) it
 // lies under, its outward normal and signed distance (Orthmann et al. 2013 sec. 4, eqs 2-9; the model is
 // heat.exposed_area). Built by the solver only when something reads it: today the heat stage's exchange
-// with the ambient air and the cone dryers (sim/heat_stage.h). Declares "surface_area" [m^2],
+// with the ambient air and the cone dryers (sim/heat_stage.h), and surface-active substances
+// (sim/substance_stage.h). Declares "surface_area" [m^2],
 // "surface_normal" (outward normal, phi [m]) and "surface_delta" [1/m], the state eq. 9 relaxes from.
 #include <CL/opencl.hpp>
 #include <string>
@@ -23,6 +24,7 @@ class SurfaceStage {
                const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout);
 
   ParticleStore::Field area() const { return area_; }
+  ExposedArea model() const { return model_; }
   ParticleStore::Field normal() const { return normal_; }
 
   // The areas, normals and deltas of the particles where they are now.

@@ -40,6 +40,36 @@
 #define SUB_M 0
 #define SUB_A 1
 #define SUB_W 2
+#ifdef THAW_SURFACE
+/* With surface-active substances, after the W blocks:
+ *   AS      a surface particle's area a_i (water with more than P.min_area of it), 0 for every other
+ *   NRM     a surface particle's 1 / sum_k M_k w(r_ik / H) over the carriers within its support (substance_norm)
+ *   MOM     a surface particle's 2-D kernel moment sum_j a_j (-p_ij . grad W2_ij) / 2 over the surface
+ *           particles j (substance_norm): 1 where the areas sample the surface evenly
+ *   PX..PZ  its point on the surface, x_i + surface_depth n_i
+ *   NX..NZ  its outward normal
+ *   G+s     its surface excess Gamma_i = S_i / a_i of substance s [kg/m^2] (0 for bulk substances) */
+#define SUB_AS (SUB_W + THAW_NSUB)
+#define SUB_NRM (SUB_AS + 1)
+#define SUB_MOM (SUB_AS + 2)
+#define SUB_PX (SUB_AS + 3)
+#define SUB_NX (SUB_AS + 6)
+#define SUB_G (SUB_AS + 9)
+
+/* Inside a walk, with point_i, normal_i and the PX.. and NX.. blocks in scope: p2, the squared distance
+ * between the surface points of i and the lanes j.. along the surface, their offset less its part along the
+ * pair's mean normal n_i + n_j. The surface points of a lattice's jagged outer layer lie up to half a spacing
+ * off the surface; counted whole, that offset made the diffusion 17 % slow on a sphere (surface-diffusion),
+ * as part of each pair's distance went across the surface, where nothing varies. The same operations on
+ * both sides of every pair. */
+#define SURFACE_PAIR(j)                                                                                    \
+  const floatV ox = point_i.x - vloadV(0, PX + (j)), oy = point_i.y - vloadV(0, PY + (j)),                \
+               oz = point_i.z - vloadV(0, PZ + (j));                                                      \
+  const floatV nx = normal_i.x + vloadV(0, NX + (j)), ny = normal_i.y + vloadV(0, NY + (j)),              \
+               nz = normal_i.z + vloadV(0, NZ + (j));                                                     \
+  const floatV nn = nx * nx + ny * ny + nz * nz, on = ox * nx + oy * ny + oz * nz;                         \
+  const floatV p2 = fmax(ox * ox + oy * oy + oz * oz - select((floatV)(0.0f), on * on / nn, nn > 0.0f), 0.0f);
+#endif
 
 float2 two_sum(float a, float b) {
   const float s = a + b;
@@ -124,8 +154,9 @@ float2 solutes(global const float2* q[4], const uint i, const SubstanceParams P)
 kernel void substance_state(global const float4* pos, global const float* density, global const float2* enthalpy,
                             global const uchar* phase, global const uchar* material, global const float2* fluid,
                             global const float4* law, global float* sub, global float* shift,
-                            global const float2* q0, global const float2* q1, global const float2* q2,
-                            global const float2* q3, const SubstanceParams P) {
+                            global float2* q0, global float2* q1, global float2* q2, global float2* q3,
+                            global const float* area, global const float4* normal, global float2* s0,
+                            global float2* s1, global float2* s2, global float2* s3, const SubstanceParams P) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uint stride = P.stride;
@@ -133,8 +164,24 @@ kernel void substance_state(global const float4* pos, global const float* densit
   const uchar mi = material[i];
   const float2 f = fluid[mi];
   const int water = phase[i] == THAW_PHASE_WATER && m > 0.0f;
-  global const float2* q[4] = {q0, q1, q2, q3};
-  const float2 held = solutes(q, i, P);
+  global float2* q[4] = {q0, q1, q2, q3};
+#ifdef THAW_SURFACE
+  /* A particle off the surface (drawn under it, frozen, or never on it) hands what it holds on its surface to
+   * its own bulk: Orthmann et al. sec. 6.1's "particles drawn under the surface transfer mass back", to the
+   * one bulk particle that is certain to be there, itself, so nothing is lost. */
+  global float2* sa[4] = {s0, s1, s2, s3};
+  const float own_area = area[i];
+  const int on_surface = water && own_area > P.min_area;
+  for (int s = 0; s < THAW_NSUB; ++s) {
+    if (!((P.surface >> s) & 1u) || on_surface) continue;
+    const float2 held_on = sa[s][i];
+    if (held_on.x == 0.0f && held_on.y == 0.0f) continue;
+    q[s][i] = add_to_pair(add_to_pair(q[s][i], held_on.x), held_on.y);
+    sa[s][i] = (float2)(0.0f);
+  }
+#endif
+  global const float2* qc[4] = {q0, q1, q2, q3};
+  const float2 held = solutes(qc, i, P);
   const float dissolved = held.x, particles = held.y;
   float carried = water ? m : 0.0f;
 #if defined(THAW_MELT_SHIFT) || defined(THAW_REJECT)
@@ -171,7 +218,75 @@ kernel void substance_state(global const float4* pos, global const float* densit
     const float2 a = q[s][i];
     sub[(SUB_W + s) * stride + i] = carried > 0.0f ? (a.x + a.y) / carried : 0.0f;
   }
+#ifdef THAW_SURFACE
+  const int surface = on_surface && carried > 0.0f;
+  sub[SUB_AS * stride + i] = surface ? own_area : 0.0f;
+  const float3 n = normal[i].xyz;
+  const float3 point = pos[i].xyz + (surface ? P.surface_depth : 0.0f) * n;
+  sub[SUB_PX * stride + i] = point.x;
+  sub[(SUB_PX + 1) * stride + i] = point.y;
+  sub[(SUB_PX + 2) * stride + i] = point.z;
+  sub[SUB_NX * stride + i] = n.x;
+  sub[(SUB_NX + 1) * stride + i] = n.y;
+  sub[(SUB_NX + 2) * stride + i] = n.z;
+  for (int s = 0; s < THAW_NSUB; ++s) {
+    const float2 a = sa[s][i];
+    sub[(SUB_G + s) * stride + i] = surface && ((P.surface >> s) & 1u) ? (a.x + a.y) / own_area : 0.0f;
+  }
+#endif
 }
+
+#ifdef THAW_SURFACE
+/* Each surface particle's 1 / sum_j M_j w(r_ij / H) over the carriers j within its support (itself among
+ * them): what its uptake from each carrier is weighted by, so the shares it takes sum to one (sec. 6.1's
+ * V_j W_ij, Shepard-normalised: a surface particle's neighbourhood is cut off by the surface, and the
+ * uptake k_a c a_i must not shrink with it). */
+kernel void substance_norm(global const float4* pos, global const float* soa, global float* sub,
+                           global const uint* cell_start, const Grid g, const SubstanceParams P) {
+  const uint i = get_global_id(0);
+  if (i >= P.n) return;
+  const uint stride = P.stride;
+  if (!(sub[SUB_AS * stride + i] > 0.0f)) {
+    sub[SUB_NRM * stride + i] = 0.0f;
+    sub[SUB_MOM * stride + i] = 0.0f;
+    return;
+  }
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
+  global const float* X = soa;
+  global const float* Y = soa + stride;
+  global const float* Z = soa + 2 * stride;
+  global const float* M = sub + SUB_M * stride;
+  const float4 pi = pos[i];
+  const int4 cell = grid_cell(g, pi);
+  global const float* AS = sub + SUB_AS * stride;
+  global const float* PX = sub + SUB_PX * stride;
+  global const float* PY = sub + (SUB_PX + 1) * stride;
+  global const float* PZ = sub + (SUB_PX + 2) * stride;
+  global const float* NX = sub + SUB_NX * stride;
+  global const float* NY = sub + (SUB_NX + 1) * stride;
+  global const float* NZ = sub + (SUB_NX + 2) * stride;
+  const float3 point_i = (float3)(PX[i], PY[i], PZ[i]), normal_i = (float3)(NX[i], NY[i], NZ[i]);
+  floatV sw = (floatV)(0.0f), sm = (floatV)(0.0f);
+  FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
+    for (uint j = jb; j < je; j += THAW_VW) {
+      PAIR_LANES(pi, j, period)
+      const floatV mj = vloadV(0, M + j);
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+      sw += select((floatV)(0.0f), mj * w_shape(sqrt(r2) * inv_H), in & (mj > 0.0f));
+      const floatV area_j = vloadV(0, AS + j);
+      SURFACE_PAIR(j)
+      /* with the pair term's eta^2, so a field quadratic along the surface gets its Laplacian exactly */
+      sm += select((floatV)(0.0f), area_j * (grad_shape(sqrt(p2) * inv_H) * p2 * p2 / (p2 + P.eta2)),
+                   in & (area_j > 0.0f) & (p2 < H2));
+    }
+  }
+  const float total = lanes_sum(sw);
+  sub[SUB_NRM * stride + i] = total > 0.0f ? 1.0f / total : 0.0f;
+  /* In 2-D the integral of -x . grad W2 over the plane is 2; x . grad W2 = sigma2 / H^4 grad_shape(q) r^2. */
+  sub[SUB_MOM * stride + i] = -0.5f * P.sigma2 * (inv_H * inv_H) * (inv_H * inv_H) * lanes_sum(sm);
+}
+#endif
 
 #if defined(THAW_MELT_SHIFT) || defined(THAW_REJECT)
 /* Ice: its melt shift, the kernel-weighted mean of the water's around it (the liquidus of the brine it
@@ -248,11 +363,27 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
 }
 #endif
 
+/* The amount a surface particle (area a, 1 / its weights' sum nrm, surface excess g) takes from a carrier of
+ * weight wgt = M w(r / H) and mass fraction wb over one step, for substance s: Orthmann et al. 2013 sec. 6.1's
+ * Langmuir-Hinshelwood flux,
+ *   Gamma_{i<-j} = a_i (M_j w_ij / sum_k M_k w_ik) [k_a c_j (1 - Gamma_i / Gamma_max) - k_d Gamma_i] dt,
+ * with c_j = rho0 w_j and the weights normalised (sec. 6.1 weights by V_j W_ij), so a well-mixed bulk gives
+ * sum_j Gamma_{i<-j} = a_i (k_a c - k_d Gamma_i) dt exactly. Eq. 10: the carrier loses what the surface takes.
+ * Both sides evaluate this one expression from the same operands, so the two amounts are equal to the bit. */
+#define ADSORBED(a, nrm, g, wgt, wb, s) \
+  ((a) * ((nrm) * (wgt)) * ((adsorb[s] * (wb)) * fmax(1.0f - (g) * inv_capacity[s], 0.0f) - desorb[s] * (g)))
+
 /* One step: each water particle's amounts change by its pairs' diffusive transfers, plus (THAW_REJECT) what
- * the giving ice around it hands it; giving ice loses what it hands out. */
+ * the giving ice around it hands it; giving ice loses what it hands out. With THAW_SURFACE, surface-active
+ * substances also move between the surface and the bulk (eq. 10, ADSORBED) and along the surface between
+ * surface particles (eq. 11): Cleary & Monaghan's pair term in 2-D on the particles' points on the surface,
+ *   dS_i/dt = sum_j 2 D_s a_i a_j (Gamma_i - Gamma_j) (p_ij . grad W2_ij) / (|p_ij|^2 + eta^2),
+ * W2 the kernel's 2-D form (the same shape with sigma_2), symmetric in i and j term by term as eq. 11 asks,
+ * where sec. 6.2's (a_i V_i + a_j V_j) is not a surface integral's weight. */
 kernel void substance_diffuse(global const float4* pos, global const float* soa, global const float* sub,
                               global const uint* cell_start, const Grid g, const SubstanceParams P,
-                              global float2* q0, global float2* q1, global float2* q2, global float2* q3) {
+                              global float2* q0, global float2* q1, global float2* q2, global float2* q3,
+                              global float2* s0, global float2* s1, global float2* s2, global float2* s3) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uint stride = P.stride;
@@ -278,6 +409,30 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
     hi[s] = (floatV)(0.0f);
     lo[s] = (floatV)(0.0f);
   }
+#ifdef THAW_SURFACE
+  global const float* AS = sub + SUB_AS * stride;
+  global const float* NRM = sub + SUB_NRM * stride;
+  global const float* PX = sub + SUB_PX * stride;
+  global const float* PY = sub + (SUB_PX + 1) * stride;
+  global const float* PZ = sub + (SUB_PX + 2) * stride;
+  global const float* NX = sub + SUB_NX * stride;
+  global const float* NY = sub + (SUB_NX + 1) * stride;
+  global const float* NZ = sub + (SUB_NX + 2) * stride;
+  const float adsorb[4] = {P.adsorb0, P.adsorb1, P.adsorb2, P.adsorb3};
+  const float desorb[4] = {P.desorb0, P.desorb1, P.desorb2, P.desorb3};
+  const float inv_capacity[4] = {P.inv_capacity0, P.inv_capacity1, P.inv_capacity2, P.inv_capacity3};
+  const float glide[4] = {P.glide0, P.glide1, P.glide2, P.glide3};
+  global const float* MOM = sub + SUB_MOM * stride;
+  const float area_i = AS[i], nrm_i = NRM[i], mom_i = MOM[i];
+  const float3 point_i = (float3)(PX[i], PY[i], PZ[i]), normal_i = (float3)(NX[i], NY[i], NZ[i]);
+  float gi[THAW_NSUB];
+  floatV shi[THAW_NSUB], slo[THAW_NSUB];
+  for (int s = 0; s < THAW_NSUB; ++s) {
+    gi[s] = sub[(SUB_G + s) * stride + i];
+    shi[s] = (floatV)(0.0f);
+    slo[s] = (floatV)(0.0f);
+  }
+#endif
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       PAIR_LANES(pi, j, period)
@@ -292,6 +447,43 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
           const floatV d = pair * ((wi[s] - vloadV(0, sub + (SUB_W + s) * stride + j)) * c[s]);
           ACCUMULATE(hi[s], lo[s], d)
         }
+#ifdef THAW_SURFACE
+        const floatV area_j = vloadV(0, AS + j);
+        const intV surface_j = in & (area_j > 0.0f);
+        if (area_i > 0.0f) {
+          /* i on the surface takes from the carriers around it (itself among them) ... */
+          const floatV wgt = select((floatV)(0.0f), mj * w_shape(qr), in & (mj > 0.0f));
+          /* ... and exchanges along the surface with the surface particles, on their points on it. */
+          SURFACE_PAIR(j)
+          /* Renormalised by the pair's mean moment 2 / (MOM_i + MOM_j), symmetric: where the areas sample
+           * the surface unevenly (a lattice sphere's jagged outer layer), the plain sum misses the Laplacian
+           * by the moment's shortfall (measured on surface-diffusion: 31-38 % too slow without it). */
+          const floatV mom_j = vloadV(0, MOM + j);
+          const floatV glide_pair = select(
+              (floatV)(0.0f),
+              (area_i * area_j) * (grad_shape(sqrt(p2) * inv_H) * p2 / (p2 + eta2)) * (2.0f / (mom_i + mom_j)),
+              surface_j & (p2 < H2) & (mom_i + mom_j > 0.0f));
+          for (int s = 0; s < THAW_NSUB; ++s) {
+            if (!((P.surface >> s) & 1u)) continue;
+            const floatV w_j = vloadV(0, sub + (SUB_W + s) * stride + j);
+            const floatV taken = ADSORBED(area_i, nrm_i, gi[s], wgt, w_j, s);
+            ACCUMULATE(shi[s], slo[s], taken)
+            const floatV glided = glide_pair * ((gi[s] - vloadV(0, sub + (SUB_G + s) * stride + j)) * glide[s]);
+            ACCUMULATE(shi[s], slo[s], glided)
+          }
+        }
+        /* i as a carrier gives to the surface particles around it (itself among them, when on the surface). */
+        if (any(surface_j)) {
+          const floatV wgt = select((floatV)(0.0f), mi * w_shape(qr), surface_j);
+          const floatV nrm_j = vloadV(0, NRM + j);
+          for (int s = 0; s < THAW_NSUB; ++s) {
+            if (!((P.surface >> s) & 1u)) continue;
+            const floatV g_j = vloadV(0, sub + (SUB_G + s) * stride + j);
+            const floatV given = -ADSORBED(area_j, nrm_j, g_j, wgt, wi[s], s);
+            ACCUMULATE(hi[s], lo[s], given)
+          }
+        }
+#endif
       }
 #ifdef THAW_REJECT
       /* Ice gives to water: the giver's amount per weight times the pair's weight, computed alike on both
@@ -313,4 +505,13 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
     const float2 d = lanes_compensated(hi[s], lo[s]);
     q[s][i] = add_to_pair(add_to_pair(q[s][i], d.x), d.y);
   }
+#ifdef THAW_SURFACE
+  global float2* sa[4] = {s0, s1, s2, s3};
+  if (area_i > 0.0f)
+    for (int s = 0; s < THAW_NSUB; ++s) {
+      if (!((P.surface >> s) & 1u)) continue;
+      const float2 d = lanes_compensated(shi[s], slo[s]);
+      sa[s][i] = add_to_pair(add_to_pair(sa[s][i], d.x), d.y);
+    }
+#endif
 }

@@ -22,11 +22,22 @@ typedef struct {
   unsigned int n;      /* particles */
   unsigned int flow;   /* 1: moving water takes its density from the density pass */
   unsigned int reject; /* bit s: water that freezes gives substance s up (its enters_ice is false) */
-  unsigned int pad0, pad1;
+  /* Surface-active substances (THAW_SURFACE; Orthmann et al. 2013 sec. 5-6.2): */
+  unsigned int surface; /* bit s: substance s is surface-active */
+  float min_area;       /* water with less surface area than this is not on the surface [m^2] */
+  /* Each one's Langmuir rates for a step of dt: k_a rho0 dt [kg/m^2 per unit mass fraction] and k_d dt */
+  float adsorb0, adsorb1, adsorb2, adsorb3;
+  float desorb0, desorb1, desorb2, desorb3;
+  float inv_capacity0, inv_capacity1, inv_capacity2, inv_capacity3; /* 1 / Gamma_max; 0: no limit [m^2/kg] */
+  /* 2 D_s dt sigma2 / H^4 [1/m^2]: the surface pair term's constant, x . grad W2 = sigma2 / H^4 grad_shape
+   * r^2 */
+  float glide0, glide1, glide2, glide3;
+  float surface_depth; /* a surface particle's point on the surface lies this far along its normal [m] */
+  float sigma2;        /* the kernel's 2-D normalisation times H^2: W2 = sigma2 / H^2 w_shape(r / H) */
 } SubstanceParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(SubstanceParams) == 80, "SubstanceParams must match its OpenCL layout");
+static_assert(sizeof(SubstanceParams) == 152, "SubstanceParams must match its OpenCL layout");
 }  // namespace thaw::substance
 #endif
 

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "sim/cl_runtime.h"
-#include "sim/schema.h"
 #include "sim/scene.h"
+#include "sim/schema.h"
 
 namespace thaw {
 
@@ -31,8 +31,8 @@ struct CaseResult {
 struct ValidationCase {
   std::string name;
   std::string summary;
-  int default_res;                  // particles across the characteristic length
-  std::function<Field()> params;    // the case's parameter document (may embed solver_schema())
+  int default_res;                // particles across the characteristic length
+  std::function<Field()> params;  // the case's parameter document (may embed solver_schema())
   std::function<CaseResult(ClRuntime&, const Json& params, int res)> run;
 };
 
@@ -40,7 +40,8 @@ const std::vector<ValidationCase>& validation_cases();
 const ValidationCase& find_case(const std::string& name);  // throws Error listing the cases
 
 // Applies --set overrides to the case's parameters, validates them (errors name the path) and runs.
-CaseResult run_validation(ClRuntime& cl, const std::string& name, int res, const std::vector<std::string>& overrides);
+CaseResult run_validation(ClRuntime& cl, const std::string& name, int res,
+                          const std::vector<std::string>& overrides);
 
 // The parameter document of a case after overrides and defaults.
 Json case_parameters(const ValidationCase& c, const std::vector<std::string>& overrides);
@@ -64,6 +65,8 @@ ValidationCase contact_angle_case();
 ValidationCase diffusion_bulk_case();
 ValidationCase brine_melting_case();
 ValidationCase conservation_case();
+ValidationCase adsorption_case();
+ValidationCase surface_diffusion_case();
 
 // A scene of ice held in still air, for the surface cases (sim/validation/surface_area.cpp): the cube
 // [-half, half]^3 at spacing dx without gravity, the ambient at air_temperature through h, heat.exposed_area

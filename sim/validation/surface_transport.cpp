@@ -1,0 +1,264 @@
+// Surface-active substances on a held sphere of water (issue 20; docs/SUBSTANCES.md): a sphere of radius R
+// sampled on the lattice (R = res spacings), particles held in place (solver.flow = false), no gravity, heat
+// off, one surface-active substance. The surface is the surface stage's (brackbill1992's areas).
+//   adsorption: the substance starts dissolved, well mixed (its bulk diffusion time R^2 / D far below the
+//     exchange's), and nothing on the surface. With Henry's law (surface_capacity 0) the surface amount S of
+//     a well-mixed bulk of volume V under an area A obeys dS/dt = k_a A (N - S) / V - k_d S, so
+//       S(t) = S_eq (1 - exp(-k t)),  k = k_d + k_a A / V,  S_eq = N (k_a A / V) / k,
+//     N the total. A and V are the model's own: the summed areas of the surface particles and the water's
+//     volume sum m / rho0, so the metrics test the exchange (eq. 10) and not the area (the surface-area
+//     case does). Metrics: the rate fitted to ln(1 - S / S_eq), the largest deviation of S from S(t) over
+//     the run (as a share of S_eq), and the closure.
+//   surface-diffusion: only on the surface (no exchange, no bulk diffusion), the surface excess starts as
+//     Gamma = Gamma0 + Gamma1 cos(theta); its l = 1 part decays as Gamma1 exp(-2 D_s t / R^2) (the surface
+//     Laplacian's eigenvalue l (l + 1) / R^2). Metrics: the decay rate fitted to the l = 1 amplitude's log
+//     (Gamma1 from the particles by least squares, sum S_i cos / sum a_i cos^2), and the closure.
+#include <chrono>
+#include <cmath>
+
+#include "sim/error.h"
+#include "sim/solver.h"
+#include "sim/substance_stage.h"
+#include "sim/validation/case.h"
+
+namespace thaw {
+namespace {
+
+// The substance's name in both cases' scenes.
+constexpr const char* kSurfactant = "surfactant";
+
+Field sphere_params(std::vector<Field> own) {
+  std::vector<Field> f = {
+      number("radius", "R of the sphere of water").in("m").def(0.005).above(0),
+      number("density", "rho of water").in("kg/m^3").def(1000.0).above(0),
+  };
+  for (Field& x : own) f.push_back(std::move(x));
+  f.push_back(solver_schema_with({{"flow", false}, {"max_dt", 3600.0}}));
+  f.push_back(
+      number("closure_gate", "Gate on the substance's closure, relative to its total").def(1e-9).above(0));
+  return object("", std::move(f));
+}
+
+// The held sphere with `substance` (its schema fields) and its concentration in the water.
+Scene sphere_scene(const std::string& name, const Json& prm, int res, const Json& substance,
+                   double concentration) {
+  if (prm["solver"]["flow"].get<bool>())
+    throw SceneError("solver.flow",
+                     "the surface transport cases hold particles in place: they need flow = false");
+  const double R = prm["radius"], dx = R / res, half = R + 3 * dx;
+  Json water = {{"material", "water"}, {"shape", "sphere"}, {"centre", {0.0, 0.0, 0.0}}, {"radius", R}};
+  if (concentration > 0) water["substances"] = {{kSurfactant, {{"concentration", concentration}}}};
+  return scene_from_json({
+      {"name", name},
+      {"domain", {{"min", {-half, -half, -half}}, {"max", {half, half, half}}}},
+      {"gravity", {0.0, 0.0, 0.0}},
+      {"spacing", dx},
+      {"solver", prm["solver"]},
+      {"heat", {{"enabled", false}}},
+      {"materials",
+       {{"water",
+         {{"kind", "fluid"},
+          {"density", prm["density"]},
+          {"conductivity", 0.56},
+          {"specific_heat", 4200.0}}}}},
+      {"substances", {{kSurfactant, substance}}},
+      {"fluids", {water}},
+  });
+}
+
+double amount(const Float2& q) { return double(q[0]) + double(q[1]); }
+
+// The least-squares slope through the origin of y against t.
+double slope_through_origin(const std::vector<double>& t, const std::vector<double>& y) {
+  double ty = 0, tt = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    ty += t[k] * y[k];
+    tt += t[k] * t[k];
+  }
+  return tt > 0 ? ty / tt : 0.0;
+}
+
+Field adsorption_params() {
+  return sphere_params({
+      number("concentration", "c0, the dissolved concentration at the start").in("kg/m^3").def(1.0).above(0),
+      number("adsorption_rate", "k_a").in("m/s").def(2e-6).above(0),
+      number("desorption_rate", "k_d").in("1/s").def(2e-3).at_least(0),
+      number("diffusivity", "D in the bulk: large enough that the bulk stays well mixed (k_a R / D << 1)")
+          .in("m^2/s")
+          .def(1e-6)
+          .above(0),
+      number("duration", "Run for this many relaxation times 1 / k").def(2.0).above(0).at_most(20),
+      integer("samples", "Times S is compared at, evenly over the run").def(40).at_least(4).at_most(1000),
+      number("rate_gate", "Gate on the relative error of the fitted rate").def(0.02).above(0),
+      number("amount_gate", "Gate on the largest |S - S(t)| over S_eq").def(0.02).above(0),
+  });
+}
+
+CaseResult run_adsorption(ClRuntime& cl, const Json& prm, int res) {
+  const Json substance = {{"kind", "surface_active"},
+                          {"diffusivity", prm["diffusivity"]},
+                          {"surface_diffusivity", 0.0},
+                          {"adsorption_rate", prm["adsorption_rate"]},
+                          {"desorption_rate", prm["desorption_rate"]},
+                          {"surface_capacity", 0.0}};
+  const Scene scene = sphere_scene("validation/adsorption", prm, res, substance, prm["concentration"]);
+  Solver solver(cl, scene, initial_state(scene));
+  solver.warm_up();
+
+  // The model's A and V: the surface particles' areas and the water's volume.
+  const HostParticles start = solver.particles();
+  const double rho0 = solver.constants().rest_density, dx = scene.spacing;
+  const float* area = start.column("surface_area")->as<float>();
+  double A = 0, V = 0;
+  for (std::size_t i = 0; i < start.size(); ++i) {
+    if (area[i] > kSurfaceMinArea * dx * dx) A += area[i];
+    V += double(start.position[i][3]) / rho0;
+  }
+  const double ka = prm["adsorption_rate"], kd = prm["desorption_rate"];
+  const double k = kd + ka * A / V;
+  const double N = solver.substance_totals().at(0);
+  const double S_eq = N * (ka * A / V) / k;
+  auto on_surface = [&] {
+    const HostParticles p = solver.particles();
+    const Float2* s = p.column(adsorbed_field(kSurfactant).name)->as<Float2>();
+    double S = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) S += amount(s[i]);
+    return S;
+  };
+
+  const double t_end = double(prm["duration"]) / k;
+  const int samples = prm["samples"];
+  std::vector<double> t, y;
+  double worst = 0;
+  double wall = 0;
+  for (int n = 1; n <= samples; ++n) {
+    const double until = t_end * n / samples;
+    const auto w0 = std::chrono::steady_clock::now();
+    while (solver.time() < until * (1.0 - 1e-12)) solver.step();
+    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    const double S = on_surface(), time = solver.time();
+    worst = std::max(worst, std::abs(S - S_eq * (1.0 - std::exp(-k * time))) / S_eq);
+    t.push_back(time);
+    y.push_back(-std::log(std::max(1.0 - S / S_eq, 1e-300)));
+  }
+  const double k_fit = slope_through_origin(t, y);
+  const double closure = solver.substance_totals().at(0) - solver.substance_books().initial.at(0);
+
+  CaseResult r;
+  r.particles = solver.size();
+  r.steps = solver.steps();
+  r.wall_s = wall;
+  r.metrics = {
+      {"rate", {k_fit, k, std::abs(k_fit - k) / k, prm["rate_gate"]}},
+      {"surface_amount", {worst, 0.0, worst, prm["amount_gate"]}},
+      {"closure", {closure, 0.0, std::abs(closure) / N, prm["closure_gate"]}},
+  };
+  return r;
+}
+
+Field surface_diffusion_params() {
+  return sphere_params({
+      number("surface_diffusivity", "D_s").in("m^2/s").def(1e-9).above(0),
+      number("mean", "Gamma0, the mean surface excess").in("kg/m^2").def(1e-6).at_least(0),
+      number("amplitude", "Gamma1, the amplitude of its cos(theta) part").in("kg/m^2").def(5e-7).above(0),
+      number("decay", "Run until Gamma1 has fallen by exp(-this)").def(1.0).above(0).at_most(5),
+      integer("samples", "Times Gamma1 is measured at, evenly over the run")
+          .def(20)
+          .at_least(2)
+          .at_most(1000),
+      number("rate_gate", "Gate on the relative error of the decay rate").def(0.03).above(0),
+  });
+}
+
+CaseResult run_surface_diffusion(ClRuntime& cl, const Json& prm, int res) {
+  const double Ds = prm["surface_diffusivity"], R = prm["radius"];
+  const Json substance = {{"kind", "surface_active"}, {"diffusivity", 0.0},     {"surface_diffusivity", Ds},
+                          {"adsorption_rate", 0.0},   {"desorption_rate", 0.0}, {"surface_capacity", 0.0}};
+  const Scene scene = sphere_scene("validation/surface-diffusion", prm, res, substance, 0.0);
+  // The areas first, then Gamma0 + Gamma1 cos(theta) times each surface particle's area on its surface.
+  HostParticles p;
+  SimState st;
+  {
+    Solver areas(cl, scene, initial_state(scene));
+    areas.warm_up();
+    st = areas.state();
+    p = areas.particles();
+  }
+  const double dx = scene.spacing, g0 = prm["mean"], g1 = prm["amplitude"];
+  const float* area = p.column("surface_area")->as<float>();
+  Float2* s = p.column(adsorbed_field(kSurfactant).name)->as<Float2>();
+  auto cosine = [&](std::size_t i) {
+    const Float4& x = p.position[i];
+    const double r = std::sqrt(double(x[0]) * x[0] + double(x[1]) * x[1] + double(x[2]) * x[2]);
+    return r > 0 ? double(x[2]) / r : 0.0;
+  };
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double a = area[i] > kSurfaceMinArea * dx * dx ? double(area[i]) : 0.0;
+    const double S = a * (g0 + g1 * cosine(i));
+    const float hi = static_cast<float>(S);
+    s[i] = {hi, static_cast<float>(S - double(hi))};
+  }
+  st.particles = p;
+  st.substances.clear();  // the books start from these amounts
+  Solver solver(cl, scene, st);
+  solver.warm_up();
+  // Gamma1 by least squares over the surface particles (positions are held, but the order is the solver's).
+  auto amplitude = [&] {
+    const HostParticles now = solver.particles();
+    const float* a = now.column("surface_area")->as<float>();
+    const Float2* q = now.column(adsorbed_field(kSurfactant).name)->as<Float2>();
+    double sc = 0, acc = 0;
+    for (std::size_t i = 0; i < now.size(); ++i) {
+      const Float4& x = now.position[i];
+      const double r = std::sqrt(double(x[0]) * x[0] + double(x[1]) * x[1] + double(x[2]) * x[2]);
+      const double c = r > 0 ? double(x[2]) / r : 0.0;
+      sc += amount(q[i]) * c;
+      if (a[i] > kSurfaceMinArea * dx * dx) acc += double(a[i]) * c * c;
+    }
+    return acc > 0 ? sc / acc : 0.0;
+  };
+  const double rate = 2.0 * Ds / (R * R);
+  const double t_end = double(prm["decay"]) / rate;
+  const int samples = prm["samples"];
+  const double a0 = amplitude();
+  std::vector<double> t, y;
+  double wall = 0;
+  for (int n = 1; n <= samples; ++n) {
+    const auto w0 = std::chrono::steady_clock::now();
+    while (solver.time() < t_end * n / samples * (1.0 - 1e-12)) solver.step();
+    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    t.push_back(solver.time());
+    y.push_back(-std::log(std::max(amplitude() / a0, 1e-300)));
+  }
+  const double fitted = slope_through_origin(t, y);
+  const double total = solver.substance_totals().at(0), initial = solver.substance_books().initial.at(0);
+
+  CaseResult r;
+  r.particles = solver.size();
+  r.steps = solver.steps();
+  r.wall_s = wall;
+  r.metrics = {
+      {"decay_rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}},
+      {"closure", {total - initial, 0.0, std::abs(total - initial) / initial, prm["closure_gate"]}},
+  };
+  return r;
+}
+
+}  // namespace
+
+ValidationCase adsorption_case() {
+  return {"adsorption",
+          "Henry adsorption onto a held sphere of well-mixed water: the surface amount relaxes at k_d + k_a "
+          "A / V "
+          "(gate 2 %) to its equilibrium split (2 %), closure 1e-9; res = spacings across R",
+          6, adsorption_params, run_adsorption};
+}
+
+ValidationCase surface_diffusion_case() {
+  return {"surface-diffusion",
+          "Surface diffusion on a held sphere: Gamma1 cos(theta) decays at 2 D_s / R^2 (gate 3 %), closure "
+          "1e-9; res = spacings across R",
+          10, surface_diffusion_params, run_surface_diffusion};
+}
+
+}  // namespace thaw
