@@ -67,6 +67,7 @@ constexpr Glyph kGlyphs[] = {
     {"+", {0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00}}, {"\u00B0", {0x0C, 0x12, 0x12, 0x0C, 0x00, 0x00, 0x00}},
     {"C", {0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E}}, {"m", {0x00, 0x00, 0x1A, 0x15, 0x15, 0x11, 0x11}},
     {"/", {0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00}}, {"s", {0x00, 0x00, 0x0E, 0x10, 0x0E, 0x01, 0x1E}},
+    {"g", {0x00, 0x0F, 0x11, 0x11, 0x0F, 0x01, 0x0E}}, {"L", {0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F}},
 };
 constexpr int kGlyphW = 5, kGlyphH = 7;
 
@@ -123,13 +124,15 @@ void draw_text(Image& image, const std::string& text, int x, int y, int scale, c
 std::array<std::string, 3> colour_bar_labels(double lo, double hi, BarUnit unit) {
   std::array<std::string, 3> out;
   const double values[3] = {hi, 0.5 * (lo + hi), lo};
-  const bool speed = unit == BarUnit::MetresPerSecond;
+  const bool speed = unit == BarUnit::MetresPerSecond, grams = unit == BarUnit::GramsPerLitre;
   for (int k = 0; k < 3; ++k) {
     char text[48];
     // "-0.0" reads as a different temperature from "0.0"; it is the same one.
-    const double v = std::abs(values[k]) < (speed ? 0.005 : 0.05) ? 0.0 : values[k];
+    const double v = std::abs(values[k]) < (speed ? 0.005 : grams ? 1e-9 : 0.05) ? 0.0 : values[k];
     if (speed)
       std::snprintf(text, sizeof text, "%.2f m/s", v);
+    else if (grams)  // 3 significant figures: a dye's fractions of a g/L and a brine's hundreds alike
+      std::snprintf(text, sizeof text, "%.3g g/L", v);
     else
       std::snprintf(text, sizeof text, "%.1f \u00B0C", v);
     out[std::size_t(k)] = text;

@@ -27,14 +27,14 @@ ColourBar draw_colour_bar(Image& image);
 // drawn left of the strip in a 5x7 pixel font (scaled with the image: 2x at 480 rows) on a dark plate, so
 // every picture of a temperature or speed view, a PNG from `thaw render` or a streamed frame, says what
 // its colours mean.
-enum class BarUnit { Celsius, MetresPerSecond };
+enum class BarUnit { Celsius, MetresPerSecond, GramsPerLitre };
 void label_colour_bar(Image& image, const ColourBar& bar, double lo, double hi,
                       BarUnit unit = BarUnit::Celsius);
 std::array<std::string, 3> colour_bar_labels(double lo, double hi,
                                              BarUnit unit = BarUnit::Celsius);  // top, middle, bottom
 
-// Text in the 5x7 font: digits, '.', '-', '+', ' ', '°', 'C', 'm', '/' and 's' (anything else is a blank
-// cell), `scale` image pixels per font pixel, its top left at (x, y); clipped to the image.
+// Text in the 5x7 font: digits, '.', '-', '+', ' ', '°', 'C', 'm', '/', 's', 'g' and 'L' (anything else is a
+// blank cell), `scale` image pixels per font pixel, its top left at (x, y); clipped to the image.
 void draw_text(Image& image, const std::string& text, int x, int y, int scale, const Rgb& colour);
 int text_width(const std::string& text, int scale);  // pixels, one blank column between characters
 

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <unordered_map>
 
@@ -79,6 +80,22 @@ struct Scalar {
   BarUnit unit;
 };
 Scalar scalar_of(const RenderSnapshot& s, const std::string& colour_by, double& lo, double& hi) {
+  if (colour_by.rfind(kSubstanceColouring, 0) == 0) {
+    const std::string name = colour_by.substr(std::strlen(kSubstanceColouring));
+    for (const auto& [sub, values] : s.substances) {
+      if (sub != name || values.size() != s.position.size()) continue;
+      // 0 to the most any particle holds, as for speed.
+      if (!(lo < hi)) {
+        lo = 0;
+        hi = 0;
+        for (float v : values) hi = std::max(hi, double(v));
+        if (hi <= 0) hi = 1e-3;
+      }
+      return {&values, BarUnit::GramsPerLitre};
+    }
+    // A substance this scene does not have (the scene changed under the view): temperature, as the slice
+    // shows for anything but speed.
+  }
   if (colour_by == "speed") {
     speed_range(s, lo, hi);
     return {&s.speed, BarUnit::MetresPerSecond};
@@ -97,9 +114,12 @@ const std::vector<std::string>& colourings() {
 void check_colouring(const std::string& value, const std::string& what) {
   const auto& names = colourings();
   if (std::find(names.begin(), names.end(), value) != names.end()) return;
+  const std::size_t n = std::strlen(kSubstanceColouring);
+  if (value.size() > n && value.compare(0, n, kSubstanceColouring) == 0) return;
   std::string list;
-  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-  throw Error(what + ": unknown colouring '" + value + "'; available: " + list);
+  for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
+  throw Error(what + ": unknown colouring '" + value + "'; available: " + list + ", " + kSubstanceColouring +
+              "<name>");
 }
 
 ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, const ParticleViewOptions& o) {

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "sim/error.h"
+#include "sim/substance_stage.h"
 
 namespace thaw {
 
@@ -36,6 +37,21 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
   if (p.velocity.size() == p.size()) {
     s.speed.reserve(p.size());
     for (const Float4& v : p.velocity) s.speed.push_back(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+  }
+  for (const Substance& sub : scene.substances) {
+    std::vector<float> c(p.size(), 0.0f);
+    for (const std::string& field : {substance_field(sub.name).name, adsorbed_field(sub.name).name}) {
+      const HostColumn* col = p.column(field);
+      if (!col || col->size() != p.size() || p.material.size() != p.size()) continue;
+      const Float2* q = col->as<Float2>();
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const double m = p.position[i][3];
+        const double rho =
+            p.material[i] < scene.materials.size() ? scene.materials[p.material[i]].density : 0.0;
+        if (m > 0 && rho > 0) c[i] += static_cast<float>((double(q[i][0]) + double(q[i][1])) * rho / m);
+      }
+    }
+    s.substances.push_back({sub.name, std::move(c)});
   }
   for (const Dryer& d : scene.dryers)
     s.dryers.push_back({d.position.cast<float>(), d.direction.normalized().cast<float>(),

@@ -3,6 +3,8 @@
 // rendering never touches the simulation's buffers (docs/ARCHITECTURE.md: render reads a snapshot).
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/particles.h"
@@ -33,11 +35,14 @@ struct RenderSnapshot {
   std::vector<std::uint8_t> glass;        // 1 for a solid particle of a transparent material; empty: none
   std::vector<float> temperature;         // [°C]; empty when the scene has no heat
   std::vector<float> speed;               // |v| [m/s]
+  // Each substance the scene declares, by name: its concentration in each particle [kg/m^3 = g/L], bulk and
+  // surface amounts over the particle's volume at its material's rest density (0 where it holds none).
+  std::vector<std::pair<std::string, std::vector<float>>> substances;
   // The scene's dryers as they are at this step, then its taps (emitters): a tap is drawn as a dryer's
   // nozzle that never blows (on = false), its radius the nozzle's.
   std::vector<DryerMarker> dryers;
-  std::vector<LampMarker> lamps;          // and its lamps
-  float spacing = 0;                      // particle spacing [m]
+  std::vector<LampMarker> lamps;  // and its lamps
+  float spacing = 0;              // particle spacing [m]
   Eigen::Vector3f domain_min = Eigen::Vector3f::Zero(), domain_max = Eigen::Vector3f::Zero();
   Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(),
                   bounds_max = Eigen::Vector3f::Zero();  // of every particle

@@ -38,8 +38,8 @@ constexpr CommandHelp kCommands[] = {
     {"render",
      "  render STATE     one frame of a state file: --out FILE.png, --view surface|particles|slice,\n"
      "                   --size WxH, --camera AZ,EL[,DIST], --target X,Y,Z, --fov DEG, --colour-by\n"
-     "                   phase|temperature, --slice AXIS[,FRACTION], --field-cells N, --quality full|fast,\n"
-     "                   --pick X,Y\n"},
+     "                   phase|temperature|speed|substance:NAME, --slice AXIS[,FRACTION], --field-cells N,\n"
+     "                   --quality full|fast, --pick X,Y\n"},
     {"info",
      "  info             OpenCL platforms and devices, and the one that would be used; the renderer\n"},
     {"scene-doc", "  scene-doc        the scene file reference (docs/SCENES.md)\n"},

@@ -126,7 +126,7 @@ Field index_field(const std::string& key, const std::string& what) {
 constexpr const char* kTypeNames[] = {
     "hello",       "dryer.set",  "dryer.aim",  "lamp.set",  "sim.pause",   "sim.resume",   "sim.step",
     "sim.reset",   "sim.speed",  "scene.load", "param.set", "camera.set",  "camera.orbit", "view.set",
-    "quality.set", "state.save", "state.load", "frame.ack", "emitter.set", "camera.reset"};
+    "quality.set", "state.save", "state.load", "frame.ack", "emitter.set", "camera.reset", "substance.drop"};
 static_assert(std::size(kTypeNames) == std::variant_size_v<Command>, "one name per command");
 
 // ---- the commands, one row each -------------------------------------------------------------------------
@@ -182,6 +182,13 @@ void read_dryer_set(DryerSet& c, const Json& v) {
 
 void read_dryer_aim(DryerAim& c, const Json& v) {
   c.dryer = v.at("dryer").get<int>();
+  c.x = v.at("x").get<double>();
+  c.y = v.at("y").get<double>();
+}
+
+void read_substance_drop(SubstanceDrop& c, const Json& v) {
+  c.substance = v.at("substance").get<std::string>();
+  c.amount = v.at("amount").get<double>();
   c.x = v.at("x").get<double>();
   c.y = v.at("y").get<double>();
 }
@@ -303,6 +310,13 @@ void read_camera_orbit(CameraOrbit& c, const Json& v) {
 void read_view_set(ViewSet& c, const Json& v) {
   c.view = v.at("view").get<std::string>();
   c.colour_by = opt<std::string>(v, "colour_by");
+  if (c.colour_by) {
+    try {
+      check_colouring(*c.colour_by, "colour_by");
+    } catch (const Error& e) {
+      throw SceneError("colour_by", std::string(e.what()).substr(std::strlen("colour_by: ")));
+    }
+  }
 }
 
 void read_quality_set(QualitySet& c, const Json& v) {
@@ -370,22 +384,26 @@ std::vector<Spec> build_specs() {
        number("d_elevation", "Change of elevation").in("deg").def(0.0),
        number("zoom", "Distance factor; < 1 moves closer").def(1.0).above(0.01).at_most(100)},
       read_camera_orbit));
-  rows.push_back(row<ViewSet>("view.set",
-                              {choice("view", {"surface", "particles", "slice"}, "What is drawn"),
-                               choice("colour_by", colourings(), "Colouring").optional()},
-                              read_view_set));
   rows.push_back(
-      row<QualitySet>("quality.set",
-                      {integer("width", "Image width").in("px").at_least(16).at_most(1920).optional(),
-                       integer("height", "Image height").in("px").at_least(16).at_most(1080).optional(),
-                       integer("jpeg_quality", "JPEG quality").at_least(10).at_most(95).optional(),
-                       number("fps", "Frame-rate cap").in("1/s").at_least(1).at_most(60).optional(),
-                       choice("surface", {"full", "fast"}, "Surface reconstruction quality").optional(),
-                       number("scale", "Fraction of width and height the surface march draws, stretched to the image")
-                           .at_least(0.25)
-                           .at_most(1)
-                           .optional()},
-                      read_quality_set));
+      row<ViewSet>("view.set",
+                   {choice("view", {"surface", "particles", "slice"}, "What is drawn"),
+                    text("colour_by",
+                         "Colouring: phase, temperature, speed, or substance:<name> for one of the "
+                         "scene's substances")
+                        .optional()},
+                   read_view_set));
+  rows.push_back(row<QualitySet>(
+      "quality.set",
+      {integer("width", "Image width").in("px").at_least(16).at_most(1920).optional(),
+       integer("height", "Image height").in("px").at_least(16).at_most(1080).optional(),
+       integer("jpeg_quality", "JPEG quality").at_least(10).at_most(95).optional(),
+       number("fps", "Frame-rate cap").in("1/s").at_least(1).at_most(60).optional(),
+       choice("surface", {"full", "fast"}, "Surface reconstruction quality").optional(),
+       number("scale", "Fraction of width and height the surface march draws, stretched to the image")
+           .at_least(0.25)
+           .at_most(1)
+           .optional()},
+      read_quality_set));
   rows.push_back(
       row<StateSave>("state.save", {text("name", "A file in the server's state folder")}, read_state_save));
   rows.push_back(
@@ -401,15 +419,26 @@ std::vector<Spec> build_specs() {
                        live("emitters[0].temperature"), live("emitters[0].start"), live("emitters[0].stop")},
                       read_emitter_set));
   rows.push_back(row<CameraReset>("camera.reset", {}));
+  rows.push_back(row<SubstanceDrop>(
+      "substance.drop",
+      {text("substance", "A substance the scene declares in `substances`"),
+       number("amount", "The dose, spread over the water and ice within a kernel's reach of the picked point")
+           .in("kg")
+           .above(0)
+           .at_most(0.01),
+       number("x", "Pixels from the left of the client's current image").at_least(0).at_most(1920),
+       number("y", "Pixels from the top of the client's current image").at_least(0).at_most(1080)},
+      read_substance_drop));
 
   // Rows in variant order, so type_name and needs_controller index them by Command::index().
   std::vector<Spec> ordered(std::variant_size_v<Command>);
-  const std::size_t indices[] = {
-      index_of<Hello>(),       index_of<DryerSet>(),  index_of<DryerAim>(),   index_of<LampSet>(),
-      index_of<SimPause>(),    index_of<SimResume>(), index_of<SimStep>(),    index_of<SimReset>(),
-      index_of<SimSpeed>(),    index_of<SceneLoad>(), index_of<ParamSet>(),   index_of<CameraSet>(),
-      index_of<CameraOrbit>(), index_of<ViewSet>(),   index_of<QualitySet>(), index_of<StateSave>(),
-      index_of<StateLoad>(),   index_of<FrameAck>(),  index_of<EmitterSet>(), index_of<CameraReset>()};
+  const std::size_t indices[] = {index_of<Hello>(),       index_of<DryerSet>(),    index_of<DryerAim>(),
+                                 index_of<LampSet>(),     index_of<SimPause>(),    index_of<SimResume>(),
+                                 index_of<SimStep>(),     index_of<SimReset>(),    index_of<SimSpeed>(),
+                                 index_of<SceneLoad>(),   index_of<ParamSet>(),    index_of<CameraSet>(),
+                                 index_of<CameraOrbit>(), index_of<ViewSet>(),     index_of<QualitySet>(),
+                                 index_of<StateSave>(),   index_of<StateLoad>(),   index_of<FrameAck>(),
+                                 index_of<EmitterSet>(),  index_of<CameraReset>(), index_of<SubstanceDrop>()};
   static_assert(std::size(indices) == std::variant_size_v<Command>, "one row per command");
   for (std::size_t i = 0; i < rows.size(); ++i) ordered[indices[i]] = std::move(rows[i]);
   for (std::size_t i = 0; i < ordered.size(); ++i) {

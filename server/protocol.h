@@ -46,6 +46,11 @@ struct DryerAim {  // aim at the surface under a pixel of the client's current i
   int dryer = 0;
   double x = 0, y = 0;  // pixels from the top left
 };
+struct SubstanceDrop {    // a dose of a substance where the surface under a pixel of the client's image is
+  std::string substance;  // a name the scene's `substances` declares
+  double amount = 0;      // [kg]
+  double x = 0, y = 0;    // pixels from the top left
+};
 struct LampSet {
   int lamp = 0;
   std::optional<bool> on;
@@ -105,7 +110,7 @@ struct FrameAck {
 
 using Command = std::variant<Hello, DryerSet, DryerAim, LampSet, SimPause, SimResume, SimStep, SimReset,
                              SimSpeed, SceneLoad, ParamSet, CameraSet, CameraOrbit, ViewSet, QualitySet,
-                             StateSave, StateLoad, FrameAck, EmitterSet, CameraReset>;
+                             StateSave, StateLoad, FrameAck, EmitterSet, CameraReset, SubstanceDrop>;
 
 // The `type` string of each command, e.g. "dryer.set".
 const char* type_name(const Command& c);

@@ -62,6 +62,16 @@ Json emitters_json(const Scene& s) {
   return out;
 }
 
+// The scene's substances, each with its kind, in the order the scene declares them: what substance.drop
+// names.
+Json substance_names(const Scene& s) {
+  Json out = Json::array();
+  for (const Substance& sub : s.substances)
+    out.push_back(
+        {{"name", sub.name}, {"kind", name(sub.kind)}, {"lowers_melting_point", sub.lowers_melting_point()}});
+  return out;
+}
+
 }  // namespace
 
 Service::Service(Session& session, RenderWorker& renderer, ServiceOptions options)
@@ -85,6 +95,7 @@ Json Service::scene_state() const {
           {"dryers", dryers_json(*scene)},
           {"lamps", lamps_json(*scene)},
           {"emitters", emitters_json(*scene)},
+          {"substances", substance_names(*scene)},
           {"view", view_json(o)},
           {"quality", quality_json()},
           {"camera", camera_json(o)},
@@ -233,6 +244,18 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
           renderer_.reset_camera(session_.scene()->camera);
           done({}, "", {{"camera", camera_json(renderer_.options())}});
         } else if constexpr (std::is_same_v<T, ViewSet>) {
+          const std::string prefix = kSubstanceColouring;
+          if (c.colour_by && c.colour_by->rfind(prefix, 0) == 0) {
+            const std::string wanted = c.colour_by->substr(prefix.size());
+            const auto scene = session_.scene();
+            const bool known = std::any_of(scene->substances.begin(), scene->substances.end(),
+                                           [&](const Substance& x) { return x.name == wanted; });
+            if (!known) {
+              done(ErrorCode::BadField,
+                   type + ": colour_by: the scene declares no substance '" + wanted + "'", Json::object());
+              return;
+            }
+          }
           renderer_.set_view(c.view, c.colour_by);
           done({}, "", Json::object());
         } else if constexpr (std::is_same_v<T, QualitySet>) {
@@ -246,6 +269,14 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
                  Json::object());
           else
             session_.aim_dryer(c.dryer, hit->hit, done);
+        } else if constexpr (std::is_same_v<T, SubstanceDrop>) {
+          const auto hit = renderer_.pick(c.x, c.y);
+          if (!hit)
+            done(ErrorCode::NotFound,
+                 type + ": no surface under pixel (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ")",
+                 Json::object());
+          else
+            session_.drop_substance(c.substance, c.amount, hit->hit, done);
         } else {
           session_.submit(r.command, done);
         }

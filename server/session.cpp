@@ -124,6 +124,11 @@ void Session::aim_dryer(int dryer, const Eigen::Vector3d& hit, Done done) {
   enqueue({Aim{dryer, hit}, std::move(done)}, "", "dryer.aim");
 }
 
+void Session::drop_substance(const std::string& substance, double amount, const Eigen::Vector3d& hit,
+                             Done done) {
+  enqueue({Drop{substance, amount, hit}, std::move(done)}, "", "substance.drop");
+}
+
 void Session::enqueue(Pending pending, const std::string& slot, const std::string& type) {
   Done superseded, busy, stopped;
   std::size_t queued = 0;
@@ -342,6 +347,8 @@ void Session::apply_pending(std::deque<Pending>& batch) {
     try {
       if (auto* a = std::get_if<Aim>(&p.what))
         o = aim(*a);
+      else if (auto* d = std::get_if<Drop>(&p.what))
+        o = drop(*d);
       else
         o = apply(std::get<protocol::Command>(p.what), p.done, deferred);
     } catch (const std::exception& e) {
@@ -415,6 +422,12 @@ Session::Outcome Session::apply(const protocol::Command& command, Done& done, bo
                            "Session::aim_dryer",
                            {}};
           },
+          [&](const protocol::SubstanceDrop&) {
+            return Outcome{ErrorCode::Failed,
+                           "substance.drop needs the picked surface point: the render side picks it, then "
+                           "calls Session::drop_substance",
+                           {}};
+          },
           [&](const auto&) {
             return Outcome{ErrorCode::Failed, "not a simulation command", {}};
           },
@@ -469,6 +482,27 @@ Session::Outcome Session::aim(const Aim& a) {
     return {ErrorCode::BadField, "the picked point is not finite or lies at the nozzle", {}};
   d.direction = toward.normalized();
   return set_dryer(a.dryer, d);
+}
+
+Session::Outcome Session::drop(const Drop& d) {
+  const std::vector<Substance>& subs = scene_.substances;
+  const auto it =
+      std::find_if(subs.begin(), subs.end(), [&](const Substance& s) { return s.name == d.substance; });
+  if (it == subs.end()) {
+    std::string names;
+    for (const Substance& s : subs) names += (names.empty() ? "" : ", ") + s.name;
+    return {ErrorCode::NotFound,
+            "substance: the scene declares no substance '" + d.substance + "'" +
+                (names.empty() ? " (it has none)" : " (it declares " + names + ")"),
+            {}};
+  }
+  try {
+    const std::size_t taken = solver_->drop_substance(std::size_t(it - subs.begin()), d.amount, d.hit);
+    dirty_ = true;
+    return {std::nullopt, "", {{"substance", d.substance}, {"amount", d.amount}, {"particles", taken}}};
+  } catch (const Error& e) {
+    return {ErrorCode::NotFound, e.what(), {}};
+  }
 }
 
 Session::Outcome Session::apply(const protocol::LampSet& c) {

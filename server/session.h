@@ -64,10 +64,15 @@ class Session {
   // the same path. And the queue holds at most kMaxQueued commands from all clients together; beyond
   // that a command is answered RateLimited at once.
   // Presentation commands (hello, camera, view, quality, frame.ack) are the render side's business and
-  // end in Failed; dryer.aim too, since it needs a pick: the render side picks, then calls aim_dryer().
+  // end in Failed; dryer.aim and substance.drop too, since they need a pick: the render side picks, then
+  // calls aim_dryer() or drop_substance().
   void submit(protocol::Command command, Done done = {});
   // Points dryer `dryer` from where it is toward `hit` [m] (a picked surface point).
   void aim_dryer(int dryer, const Eigen::Vector3d& hit, Done done = {});
+  // Puts `amount` kg of `substance` into the water and ice around `hit` [m] (a picked surface point):
+  // substance.drop, after the render side's pick.
+  void drop_substance(const std::string& substance, double amount, const Eigen::Vector3d& hit,
+                      Done done = {});
 
   // Writes the current state to `path` (for --state-out at shutdown). On the session's thread while it
   // runs (blocking the caller until written), directly when it does not; throws Error on failure.
@@ -106,9 +111,14 @@ class Session {
     int dryer = 0;
     Eigen::Vector3d hit = Eigen::Vector3d::Zero();
   };
+  struct Drop {
+    std::string substance;
+    double amount = 0;
+    Eigen::Vector3d hit = Eigen::Vector3d::Zero();
+  };
   using Task = std::function<void()>;  // internal work on the session's thread (save_state)
   struct Pending {
-    std::variant<protocol::Command, Aim, Task> what;
+    std::variant<protocol::Command, Aim, Drop, Task> what;
     Done done;
   };
   struct Outcome {
@@ -137,6 +147,7 @@ class Session {
   Outcome apply(const protocol::StateSave& c);
   Outcome apply(const protocol::StateLoad& c);
   Outcome aim(const Aim& a);
+  Outcome drop(const Drop& d);
   // Into the running solver, the scene and its published copy (dryer.set, lamp.set, dryer.aim and
   // param.set of a field the schema marks live in place).
   Outcome set_dryer(int index, const Dryer& d);

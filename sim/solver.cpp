@@ -11,6 +11,7 @@
 #include "sim/cl_launch.h"
 #include "sim/error.h"
 #include "sim/kernels/dryer_model.h"
+#include "sim/kernels/sph_kernel.h"
 #include "sim/photons.h"
 #include "sim/rigid_ice.h"
 #include "sim/thermal.h"
@@ -967,6 +968,69 @@ SimState Solver::state() const {
     s.rigid_labelling = std::move(r.labelling);
   }
   return s;
+}
+
+std::size_t Solver::drop_substance(std::size_t s, double amount, const Eigen::Vector3d& at) {
+  if (!substances_ || s >= scene_.substances.size())
+    throw Error("substance.drop: the scene has no substance " + std::to_string(s));
+  if (!(amount > 0) || !std::isfinite(amount))
+    throw Error("substance.drop: amount " + std::to_string(amount) + " kg must be positive");
+  if (!at.allFinite()) throw Error("substance.drop: the point is not finite");
+  std::vector<Float4> x(n_);
+  std::vector<std::uint8_t> phase(n_);
+  auto& q = cl_.queue();
+  if (n_ > 0) {
+    q.enqueueReadBuffer(store_[f_.position], CL_FALSE, 0, n_ * sizeof(Float4), x.data());
+    q.enqueueReadBuffer(store_[f_.phase], CL_TRUE, 0, n_, phase.data());
+  }
+  // Shares by the kernel's weight among the water and ice within its support of the point; where none is
+  // that near (the point lies on a thin film's rendered surface, say), the nearest within three supports.
+  const double H = k_.support;
+  const bool wendland = scene_.solver.kernel == KernelFunction::WendlandC2;
+  std::vector<std::pair<std::size_t, double>> share;
+  double sum = 0, nearest = 9 * H * H;
+  std::size_t closest = n_;
+  for (std::size_t i = 0; i < n_; ++i) {
+    const auto ph = static_cast<Phase>(phase[i]);
+    if ((ph != Phase::Water && ph != Phase::Ice) || !(x[i][3] > 0)) continue;
+    const double r2 = (Eigen::Vector3d(x[i][0], x[i][1], x[i][2]) - at).squaredNorm();
+    if (r2 < nearest) {
+      nearest = r2;
+      closest = i;
+    }
+    if (r2 >= H * H) continue;
+    const float r = static_cast<float>(std::sqrt(r2));
+    const double w = wendland ? sph::wendland_c2_w(r, float(H)) : sph::cubic_spline_w(r, float(H));
+    if (w > 0) {
+      share.push_back({i, w});
+      sum += w;
+    }
+  }
+  if (share.empty() && closest < n_) {
+    share.push_back({closest, 1.0});
+    sum = 1.0;
+  }
+  if (share.empty()) {
+    std::ostringstream os;
+    os << "substance.drop: no water or ice within " << 3 * H << " m of the point (" << at.x() << ", "
+       << at.y() << ", " << at.z() << ")";
+    throw Error(os.str());
+  }
+  // Each share added to the particle's (hi, lo) pair; the books take what was added.
+  const cl::Buffer& field = store_[substances_->fields()[s]];
+  double added = 0;
+  for (const auto& [i, w] : share) {
+    Float2 v;
+    q.enqueueReadBuffer(field, CL_TRUE, i * sizeof(Float2), sizeof(Float2), &v);
+    const double before = double(v[0]) + double(v[1]);
+    const double now = before + amount * w / sum;
+    v[0] = static_cast<float>(now);
+    v[1] = static_cast<float>(now - double(v[0]));
+    added += (double(v[0]) + double(v[1])) - before;
+    q.enqueueWriteBuffer(field, CL_TRUE, i * sizeof(Float2), sizeof(Float2), &v);
+  }
+  substance_books_.inflow[s] += added;
+  return share.size();
 }
 
 std::vector<double> Solver::substance_totals() const {

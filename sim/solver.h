@@ -141,6 +141,10 @@ class Solver {
   // double, and its account.
   std::vector<double> substance_totals() const;
   const SubstanceBooks& substance_books() const { return substance_books_; }
+  // Puts `amount` kg of substance s into the water and ice around `at` [m] (substance.drop): shared by the
+  // kernel's weight among those within its support, else given to the nearest within three supports, and
+  // booked as inflow. Returns how many particles took a share; throws Error when none is near enough.
+  std::size_t drop_substance(std::size_t s, double amount, const Eigen::Vector3d& at);
   // How far below its material's melting point each particle melts [K], as the last step's substance stage
   // left it (sim/substance_stage.h); empty unless substances lower the melting point.
   std::vector<float> melt_shifts() const;

@@ -19,6 +19,8 @@ let paused = false;
 let dryers = [];          // the scene's dryers as the server last described them
 let lamps = [];           // its lamps
 let emitters = [];        // and its taps (emitters), with their flow in L/s
+let substances = [];      // and the substances it declares, by name, for substance.drop
+let substanceBooks = {};  // each substance's account from the last stats: {total, inflow, closure, ...} [kg]
 let tension = 'none';     // the tension model in force (tension.model)
 let history = [];         // [sim time, ice fraction or null, mean temperature or null]
 let pace = [];            // [wall ms, sim time] of recent stats, for the simulated seconds per wall second
@@ -98,6 +100,17 @@ function applyScene(m) {
   dryers = m.dryers || [];
   lamps = m.lamps || [];
   emitters = m.emitters || [];
+  substances = m.substances || [];
+  fillSelect($('substance'), substances.map((x) => x.name), substances.length ? substances[0].name : '');
+  // The colourings: the fixed three, then each of the scene's substances (g/L).
+  const colour = $('colour-by');
+  for (const o of [...colour.options]) if (o.value.startsWith('substance:')) o.remove();
+  for (const x of substances) {
+    const o = document.createElement('option');
+    o.value = `substance:${x.name}`;
+    o.textContent = `by ${x.name} (g/L)`;
+    colour.appendChild(o);
+  }
   fillSelect($('dryer'), indices(dryers), '0');
   fillSelect($('lamp'), indices(lamps), '0');
   fillSelect($('emitter'), indices(emitters), '0');
@@ -114,6 +127,11 @@ function applyLists() {
   $('dryers').hidden = dryers.length === 0;
   $('lamps').hidden = lamps.length === 0;
   $('taps').hidden = emitters.length === 0;
+  $('substances').hidden = substances.length === 0;
+  if (substances.length === 0 && $('drop').checked) {
+    $('drop').checked = false;
+    canvas.classList.remove('aiming');
+  }
   showDryer();
   showLamp();
   showEmitter();
@@ -200,6 +218,8 @@ function simRate() {
 
 function onStats(m) {
   applyPaused(m.paused);
+  substanceBooks = m.substances || {};
+  showSubstance();
   if (m.dryers) dryers = m.dryers;
   if (m.lamps) lamps = m.lamps;
   if (m.emitters) {
@@ -367,6 +387,7 @@ canvas.addEventListener('pointerdown', (e) => {
   drag = { x: e.offsetX, y: e.offsetY };
   canvas.setPointerCapture(e.pointerId);
   if ($('aim').checked) aimAt(e);
+  if ($('drop').checked) dropAt(e);
 });
 canvas.addEventListener('pointermove', (e) => {
   if (!drag) return;
@@ -374,6 +395,7 @@ canvas.addEventListener('pointermove', (e) => {
     aimAt(e);
     return;
   }
+  if ($('drop').checked) return;  // one dose a click
   const dx = e.offsetX - drag.x, dy = e.offsetY - drag.y;
   drag = { x: e.offsetX, y: e.offsetY };
   if (dx || dy) send('camera.orbit', { d_azimuth: -0.4 * dx, d_elevation: 0.4 * dy });
@@ -393,8 +415,34 @@ function aimAt(e) {
   send('dryer.aim', { dryer: currentDryer(), x: e.offsetX * sx, y: e.offsetY * sy });
 }
 
+// How much of the chosen substance the scene holds, and how much was dropped or poured in.
+function showSubstance() {
+  const b = substanceBooks[$('substance').value];
+  $('substance-total').textContent = b ? `${(1e3 * b.total).toPrecision(3)} g held, ${(1e3 * b.inflow).toPrecision(3)} g added` : '';
+}
+$('substance').addEventListener('change', showSubstance);
+
+// A dose of the chosen substance where the surface under the pointer is (the server picks it as for aim).
+function dropAt(e) {
+  const sx = canvas.width / canvas.clientWidth, sy = canvas.height / canvas.clientHeight;
+  send('substance.drop', {
+    substance: $('substance').value,
+    amount: Number($('substance-amount').value),
+    x: e.offsetX * sx,
+    y: e.offsetY * sy,
+  });
+}
+
 // ---- controls -> commands ---------------------------------------------------------------------------
-$('aim').addEventListener('change', () => canvas.classList.toggle('aiming', $('aim').checked));
+// Aiming a dryer and dropping a substance both take the canvas's clicks: one at a time.
+$('aim').addEventListener('change', () => {
+  if ($('aim').checked) $('drop').checked = false;
+  canvas.classList.toggle('aiming', $('aim').checked || $('drop').checked);
+});
+$('drop').addEventListener('change', () => {
+  if ($('drop').checked) $('aim').checked = false;
+  canvas.classList.toggle('aiming', $('aim').checked || $('drop').checked);
+});
 $('pause').addEventListener('click', () => send(paused ? 'sim.resume' : 'sim.pause'));
 $('step').addEventListener('click', () => send('sim.step', { n: 10 }));
 $('reset').addEventListener('click', () => send('sim.reset'));

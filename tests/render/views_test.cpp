@@ -134,6 +134,33 @@ TEST(ParticleView, SpeedColoursRunFromStillToTheFastest) {
   EXPECT_THROW(render_particles(s, cam, o), Error);
 }
 
+// By a substance (issue 20): its concentration from 0 to the most any particle holds, labelled in g/L; a
+// substance the snapshot lacks falls back to temperature; the name must follow "substance:".
+TEST(ParticleView, SubstanceColoursRunFromNoneToTheMost) {
+  RenderSnapshot s = two_particles(-5.0f, 20.0f);
+  s.substances = {{"salt", {0.0f, 0.0f}}, {"dye", {0.0f, 2.0f}}};
+  const OrbitCamera cam = front_camera();
+  ParticleViewOptions o;
+  o.colour_by = "substance:dye";
+  const ViewImage v = render_particles(s, cam, o);
+  EXPECT_DOUBLE_EQ(v.t_min, 0.0);
+  EXPECT_DOUBLE_EQ(v.t_max, 2.0);
+  int x = 0, y = 0;
+  project(cam, s.position[0], x, y);
+  EXPECT_GT(chroma(v.image.pixel(x, y)).dot(chroma(cool_warm(0.0))), 0.999);
+  project(cam, s.position[1], x, y);
+  EXPECT_GT(chroma(v.image.pixel(x, y)).dot(chroma(cool_warm(1.0))), 0.999);
+  EXPECT_EQ(colour_bar_labels(0, 2.0, BarUnit::GramsPerLitre),
+            (std::array<std::string, 3>{"2 g/L", "1 g/L", "0 g/L"}));
+  o.colour_by = "substance:ink";
+  const ViewImage t = render_particles(s, cam, o);
+  EXPECT_DOUBLE_EQ(t.t_min, -5.0);
+  EXPECT_DOUBLE_EQ(t.t_max, 20.0);
+  EXPECT_NO_THROW(check_colouring("substance:salt", "colour_by"));
+  EXPECT_THROW(check_colouring("substance:", "colour_by"), Error);
+  EXPECT_THROW(check_colouring("salt", "colour_by"), Error);
+}
+
 TEST(ParticleView, UnknownColouringAndMissingTemperaturesAreErrors) {
   RenderSnapshot s = two_particles(0.0f, 1.0f);
   ParticleViewOptions o;
@@ -154,7 +181,8 @@ TEST(SliceView, LinearTemperatureRunsAcrossTheColourBar) {
   for (int i = 0; i < 20; ++i)
     for (int j = 0; j < 10; ++j)
       for (int k = 0; k < 10; ++k) {
-        const Eigen::Vector3f x(-0.095f + 0.01f * float(i), -0.045f + 0.01f * float(j), -0.045f + 0.01f * float(k));
+        const Eigen::Vector3f x(-0.095f + 0.01f * float(i), -0.045f + 0.01f * float(j),
+                                -0.045f + 0.01f * float(k));
         s.position.push_back(x);
         s.phase.push_back(static_cast<std::uint8_t>(Phase::Water));
         s.temperature.push_back(100.0f * x.x());

@@ -151,6 +151,42 @@ async def scenario(call, js, until):
   EXPECT_TRUE(served.stop()) << served.log();
 }
 
+// The Substances panel (issue 20): in salt-on-ice it lists the scene's substances; with "drop" ticked, a
+// click on the ice drops the chosen dose of salt there (the salt's inflow in the stats grows by it); the
+// Colour menu offers each substance, and choosing one colours the particle view by it.
+TEST(BrowserClient, TheSubstancesPanelDropsSaltWhereTheClickIs) {
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
+      << "Debian's chromium is not installed (scripts/setup)";
+  TempDir dir("browser-substances");
+  ServedScene served(dir, "salt-on-ice --set spacing=0.004 --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(in_chromium(R"py(
+async def scenario(call, js, until):
+    print("panel", await until("!document.getElementById('substances').hidden && substances.length === 2", 30))
+    print("frames", bool(await until("framesSeen > 0 || fps > 0", 30)))
+    print("books", bool(await until("substanceBooks.salt && substanceBooks.salt.total > 0", 30)))
+    await js("{ const a = document.getElementById('substance-amount'); a.value = '0.001'; }")
+    await js("document.getElementById('drop').click()")
+    box = await js("(() => { const r = document.getElementById('view').getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; })()")
+    x, y = box[0] + 0.5 * box[2], box[1] + 0.55 * box[3]
+    for kind in ("mousePressed", "mouseReleased"):
+        await call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left", clickCount=1)
+    print("dropped", bool(await until("substanceBooks.salt && Math.abs(substanceBooks.salt.inflow - 0.001) < 1e-12", 30)))
+    print("closed", await js("Math.abs(substanceBooks.salt.closure_relative) < 1e-12"))
+    print("menu", await js("[...document.getElementById('colour-by').options].map(o => o.value).join(',')"))
+    await js("{ document.getElementById('view-kind').value = 'particles'; document.getElementById('colour-by').value = 'substance:salt'; document.getElementById('colour-by').dispatchEvent(new Event('change')); }")
+    print("coloured", bool(await until("document.getElementById('colour-by').value === 'substance:salt' && document.getElementById('message').textContent === ''", 20)))
+)py"),
+                                            240, &status);
+  EXPECT_EQ(status, 0) << out;
+  expect_lines(
+      out, {"connected True", "panel True", "frames True", "books True", "dropped True", "closed True",
+            "menu phase,temperature,speed,substance:salt,substance:dye", "coloured True", "screenshot True"});
+  std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
+  EXPECT_TRUE(served.stop()) << served.log();
+}
+
 // An air scene's page (issue 18): the readout says how much air there is and how warm (the dryer's jet
 // shows in the air's top temperature), and calls what comes in and goes out what it is, air, not water
 // poured; the readout's lines stay within the picture.
@@ -184,7 +220,8 @@ async def scenario(call, js, until):
 // limit on a loaded machine), while the water moves; the page says how fast time runs and the heat
 // factor; the picture where the ice was changes. Screenshots at the start and at 10 % are saved.
 TEST(BrowserClient, TheDefaultSceneVisiblyMeltsWithinAMinute) {
-  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium")) << "Debian's chromium is not installed (scripts/setup)";
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
+      << "Debian's chromium is not installed (scripts/setup)";
   TempDir dir("browser-melt");
   ServedScene served(dir, "default --state-dir states");
   ASSERT_GT(served.port(), 0) << served.log();
@@ -227,7 +264,8 @@ async def scenario(call, js, until):
   // THAW_TEST_SCREENSHOTS=DIR keeps them (docs/images/browser-melt-*.png come from here).
   if (const char* keep = std::getenv("THAW_TEST_SCREENSHOTS"))
     for (const char* name : {"melt-start.png", "melt-10.png"})
-      std::filesystem::copy_file(dir.path() / name, std::filesystem::path(keep) / ("browser-" + std::string(name)),
+      std::filesystem::copy_file(dir.path() / name,
+                                 std::filesystem::path(keep) / ("browser-" + std::string(name)),
                                  std::filesystem::copy_options::overwrite_existing);
   EXPECT_TRUE(served.stop()) << served.log();
 }

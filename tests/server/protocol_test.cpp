@@ -81,6 +81,7 @@ const std::vector<std::string>& valid_messages() {
       R"({"type":"emitter.set","emitter":0,"open":true,"position":[0.04,0.04,0.09],"direction":[0,1,-2],)"
       R"("radius":0.006,"speed":0.8,"temperature":40,"start":0.5,"stop":3})",
       R"({"type":"camera.reset"})",
+      R"({"type":"substance.drop","substance":"salt","amount":0.0001,"x":320,"y":240})",
   };
   return messages;
 }
@@ -157,6 +158,15 @@ TEST(ProtocolParse, DryerAim) {
   EXPECT_EQ(a.x, 320.0);
   EXPECT_EQ(a.y, 240.0);
   EXPECT_EQ(parsed<DryerAim>(R"({"type":"dryer.aim","dryer":0,"x":0.5,"y":0})").x, 0.5);
+}
+
+TEST(ProtocolParse, SubstanceDrop) {
+  const SubstanceDrop d = parsed<SubstanceDrop>(valid_messages().back());
+  EXPECT_EQ(d.substance, "salt");
+  EXPECT_EQ(d.amount, 0.0001);
+  EXPECT_EQ(d.x, 320.0);
+  EXPECT_EQ(d.y, 240.0);
+  EXPECT_TRUE(needs_controller(Command{d}));
 }
 
 TEST(ProtocolParse, LampSet) {
@@ -271,6 +281,8 @@ TEST(ProtocolParse, ViewAndQuality) {
   const ViewSet slice = parsed<ViewSet>(R"({"type":"view.set","view":"slice"})");
   EXPECT_EQ(slice.view, "slice");
   EXPECT_FALSE(slice.colour_by);
+  EXPECT_EQ(parsed<ViewSet>(R"({"type":"view.set","view":"slice","colour_by":"substance:salt"})").colour_by,
+            "substance:salt");
 
   const QualitySet q = parsed<QualitySet>(valid_messages()[14]);
   EXPECT_EQ(q.width, 640);
@@ -279,7 +291,8 @@ TEST(ProtocolParse, ViewAndQuality) {
   EXPECT_EQ(q.fps, 15.0);
   EXPECT_EQ(q.surface, "fast");
   const QualitySet fps_only = parsed<QualitySet>(R"({"type":"quality.set","fps":60})");
-  EXPECT_FALSE(fps_only.width || fps_only.height || fps_only.jpeg_quality || fps_only.surface || fps_only.scale);
+  EXPECT_FALSE(fps_only.width || fps_only.height || fps_only.jpeg_quality || fps_only.surface ||
+               fps_only.scale);
   EXPECT_EQ(parsed<QualitySet>(R"({"type":"quality.set","scale":0.5})").scale, 0.5);
 }
 
@@ -445,6 +458,21 @@ TEST(ProtocolRefuse, DryerAim) {
   });
 }
 
+TEST(ProtocolRefuse, SubstanceDrop) {
+  expect_bad_fields({
+      {R"({"type":"substance.drop","amount":0.001,"x":1,"y":1})", "substance.drop", "substance"},
+      {R"({"type":"substance.drop","substance":"salt","x":1,"y":1})", "substance.drop", "amount"},
+      {R"({"type":"substance.drop","substance":"salt","amount":0,"x":1,"y":1})", "substance.drop", "amount"},
+      {R"({"type":"substance.drop","substance":"salt","amount":-1,"x":1,"y":1})", "substance.drop", "amount"},
+      {R"({"type":"substance.drop","substance":"salt","amount":1,"x":1,"y":1})", "substance.drop", "amount"},
+      {R"({"type":"substance.drop","substance":7,"amount":0.001,"x":1,"y":1})", "substance.drop",
+       "substance"},
+      {R"({"type":"substance.drop","substance":"salt","amount":0.001,"y":1})", "substance.drop", "x"},
+      {R"({"type":"substance.drop","substance":"salt","amount":0.001,"x":1,"y":5000})", "substance.drop",
+       "y"},
+  });
+}
+
 TEST(ProtocolRefuse, LampSet) {
   const std::string l = R"({"type":"lamp.set","lamp":0,)";
   expect_bad_fields({
@@ -569,6 +597,8 @@ TEST(ProtocolRefuse, ViewAndQuality) {
       {R"({"type":"view.set","view":"wireframe"})", "view.set", "view"},
       {R"({"type":"view.set","view":1})", "view.set", "view"},
       {R"({"type":"view.set","view":"surface","colour_by":"velocity"})", "view.set", "colour_by"},
+      {R"({"type":"view.set","view":"surface","colour_by":"substance:"})", "view.set", "colour_by"},
+      {R"({"type":"view.set","view":"surface","colour_by":3})", "view.set", "colour_by"},
       {R"({"type":"quality.set","width":15})", "quality.set", "width"},
       {R"({"type":"quality.set","width":1921})", "quality.set", "width"},
       {R"({"type":"quality.set","width":640.5})", "quality.set", "width"},
@@ -597,8 +627,8 @@ TEST(ProtocolRefuse, FrameAck) {
 
 TEST(ProtocolRoles, NeedsControllerForWhatEveryoneSees) {
   // quality.set sets the cost of the frame every client shares: controller only.
-  const std::vector<std::string> viewer = {"hello",    "camera.set", "camera.orbit",
-                                           "camera.reset", "view.set", "frame.ack"};
+  const std::vector<std::string> viewer = {"hello",        "camera.set", "camera.orbit",
+                                           "camera.reset", "view.set",   "frame.ack"};
   for (const std::string& text : valid_messages()) {
     const Command c = std::get<Request>(parse(text)).command;
     const bool presentation = std::find(viewer.begin(), viewer.end(), type_name(c)) != viewer.end();

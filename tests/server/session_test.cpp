@@ -138,6 +138,42 @@ TEST_F(SessionTest, DryerSetMergesIntoTheDryerAndRefusesBadValues) {
   EXPECT_TRUE(s->scene()->dryers[0].direction.isApprox(Eigen::Vector3d(0.6, 0, -0.8), 1e-9));
 }
 
+// substance.drop after the pick: the dose goes into the ice and water around the point and into the books;
+// a name the scene does not declare, or a point far from any water or ice, is not_found and changes nothing.
+TEST_F(SessionTest, DropsASubstanceWhereThePickWasAndBooksIt) {
+  auto s = make("salt-on-ice", {"spacing=0.004"});
+  s->start();
+  wait_for_stats(*s, [](const Json& j) { return j["steps"].get<std::uint64_t>() >= 1; });
+  auto drop = [&](const std::string& name, double amount, const Eigen::Vector3d& at) {
+    auto promise = std::make_shared<std::promise<Reply>>();
+    auto answer = promise->get_future();
+    s->drop_substance(name, amount, at,
+                      [promise](std::optional<ErrorCode> code, std::string message, Json result) {
+                        promise->set_value(Reply{true, code, std::move(message), std::move(result)});
+                      });
+    EXPECT_EQ(answer.wait_for(20s), std::future_status::ready);
+    return answer.get();
+  };
+  Reply r = drop("salt", 1e-4, Eigen::Vector3d(0.05, 0.05, 0.01));  // on the dry ice's top
+  ASSERT_FALSE(r.code) << r.message;
+  EXPECT_GT(r.result["particles"].get<int>(), 1);
+  // The next stats carry the dose as the salt's inflow, and the books still close.
+  auto stats = wait_for_stats(*s, [](const Json& j) {
+    return j.contains("substances") && j["substances"]["salt"]["inflow"].get<double>() > 0;
+  });
+  ASSERT_TRUE(stats);
+  const Json& salt = (*stats)["substances"]["salt"];
+  EXPECT_NEAR(salt["inflow"].get<double>(), 1e-4, 1e-15);
+  EXPECT_LT(std::abs(salt["closure_relative"].get<double>()), 1e-12) << salt.dump();
+
+  r = drop("pepper", 1e-4, Eigen::Vector3d(0.05, 0.05, 0.01));
+  EXPECT_EQ(r.code, ErrorCode::NotFound);
+  EXPECT_NE(r.message.find("salt, dye"), std::string::npos) << r.message;
+  r = drop("dye", 1e-4, Eigen::Vector3d(0.5, 0.5, 0.5));
+  EXPECT_EQ(r.code, ErrorCode::NotFound);
+  EXPECT_NE(r.message.find("no water or ice"), std::string::npos) << r.message;
+}
+
 TEST_F(SessionTest, PauseHoldsTimeAndStepAdvancesExactly) {
   auto s = make("ice-on-plate");
   s->start();
@@ -429,8 +465,8 @@ TEST_F(SessionTest, StatsCarryTheWaterThatRanOutThroughAnOpenSide) {
 // The same with DFSPH: water runs out through the open side with every particle accounted for, and the
 // stats carry the pressure solves.
 TEST_F(SessionTest, DfsphRunsLiveWithItsSolvesInTheStatsAndWaterRunsOut) {
-  auto s = make("dam-break", {"spacing=0.02", "solver.pressure=dfsph", "domain.walls=[\"-x\", \"-y\", \"+y\", \"-z\"]",
-                              "domain.open=[\"+x\"]"});
+  auto s = make("dam-break", {"spacing=0.02", "solver.pressure=dfsph",
+                              "domain.walls=[\"-x\", \"-y\", \"+y\", \"-z\"]", "domain.open=[\"+x\"]"});
   const std::size_t water = initial_state(*s->scene()).particles.count(Phase::Water);
   s->start();
   const auto stats = wait_for_stats(
@@ -441,8 +477,9 @@ TEST_F(SessionTest, DfsphRunsLiveWithItsSolvesInTheStatsAndWaterRunsOut) {
   EXPECT_LE(d["density"]["error"].get<double>(), d["density"]["tolerance"].get<double>());
   EXPECT_EQ(d["unconverged_density_steps"].get<int>(), 0);
   ASSERT_TRUE(stats->contains("outflow")) << stats->dump();
-  EXPECT_EQ((*stats)["particles"]["water"].get<std::size_t>() + (*stats)["outflow"]["particles"].get<std::size_t>(),
-            water);
+  EXPECT_EQ(
+      (*stats)["particles"]["water"].get<std::size_t>() + (*stats)["outflow"]["particles"].get<std::size_t>(),
+      water);
 }
 
 // Free ice under DFSPH in the live service: the default scene (coarse) runs with its three free bodies,
@@ -527,8 +564,8 @@ TEST_F(RenderWorkerTest, TheCameraStaysOnTheSceneAndFramesKeepWithinThePixelBudg
   w.set_quality(std::nullopt, std::nullopt, std::nullopt, std::nullopt, "fast", 0.75);
   EXPECT_EQ(w.fps_limit(), w.fps_cap());
   w.set_quality(std::nullopt, std::nullopt, std::nullopt, std::nullopt, "full", 1.0);
-  EXPECT_NEAR(w.fps_limit(), RenderWorker::kMaxPixelsPerSecond / (640.0 * 480 * RenderWorker::kFullQualityWeight),
-              1e-9);
+  EXPECT_NEAR(w.fps_limit(),
+              RenderWorker::kMaxPixelsPerSecond / (640.0 * 480 * RenderWorker::kFullQualityWeight), 1e-9);
   w.set_quality(1920, 1080, 95, 60.0, "full");
   EXPECT_EQ(w.fps_cap(), 60.0);
   EXPECT_NEAR(w.fps_limit(),
@@ -656,7 +693,8 @@ TEST_F(RenderWorkerTest, UnwatchedDrawsOnlyItsFirstFrameAndHurrySkipsTheFpsCap) 
 TEST_F(RenderWorkerTest, FramesMarchAtHalfScaleWhileTheCameraMovesAndOneAtTheChosenScaleFollows) {
   Session s(cl(), "ice-on-plate", {"spacing=0.006"}, (dir_.path() / "states").string());  // not started
   RenderWorker w(s);
-  EXPECT_THROW(w.set_quality(std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt, 0.2), Error);
+  EXPECT_THROW(w.set_quality(std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt, 0.2),
+               Error);
   w.set_quality(160, 120, 70, 60.0, "fast", 0.75);
   EXPECT_EQ(w.options().scale, 0.75);
   w.start();

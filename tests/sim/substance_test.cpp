@@ -344,6 +344,37 @@ TEST_F(SubstanceTest, SaltOnDryIceMeltsItIntoBrine) {
   EXPECT_LT(std::abs(s.total_enthalpy() - b.initial - b.heat_in()), 1e-6 * std::abs(b.initial));
 }
 
+// A dose dropped at a point (substance.drop) goes to the water within a kernel's reach of it, shared by the
+// kernel's weight, and into the books as inflow; far from any water or ice it is refused.
+TEST_F(SubstanceTest, ADroppedDoseGoesToTheWaterAroundThePointAndIntoTheBooks) {
+  const Scene scene = scene_from_json(dyed_tank(false));
+  Solver s(cl(), scene, initial_state(scene));
+  for (int i = 0; i < 5; ++i) s.step();
+  const std::vector<double> before = amounts(s.particles(), "dye");
+  const Eigen::Vector3d at(0.03, 0.01, 0.006);  // in the clear layer
+  const std::size_t taken = s.drop_substance(0, 1e-6, at);
+  EXPECT_GT(taken, 5u);
+  const HostParticles p = s.particles();
+  const std::vector<double> after = amounts(p, "dye");
+  double added = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double d = after[i] - before[i];
+    added += d;
+    const Eigen::Vector3d x(p.position[i][0], p.position[i][1], p.position[i][2]);
+    if (d != 0.0) {
+      EXPECT_LT((x - at).norm(), s.constants().support) << "particle " << p.id[i];
+    }
+  }
+  EXPECT_NEAR(added, 1e-6, 1e-15);
+  EXPECT_NEAR(s.substance_books().inflow[0], 1e-6, 1e-15);
+  for (int i = 0; i < 20; ++i) s.step();
+  const SubstanceBooks& b = s.substance_books();
+  EXPECT_LT(std::abs(s.substance_totals()[0] - b.initial[0] - b.inflow[0]), 1e-12 * b.initial[0]);
+  EXPECT_THROW(s.drop_substance(0, 1e-6, Eigen::Vector3d(1.0, 1.0, 1.0)), Error);
+  EXPECT_THROW(s.drop_substance(0, -1e-6, at), Error);
+  EXPECT_THROW(s.drop_substance(5, 1e-6, at), Error);
+}
+
 TEST_F(SubstanceTest, ConservationCasePassesAtCiResolution) {
   const CaseResult r = run_validation(cl(), "conservation", 4, {});
   for (const auto& [name, m] : r.metrics) EXPECT_TRUE(m.passed()) << name << ": error " << m.error;
