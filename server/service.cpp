@@ -261,20 +261,15 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
         } else if constexpr (std::is_same_v<T, QualitySet>) {
           renderer_.set_quality(c.width, c.height, c.jpeg_quality, c.fps, c.surface, c.scale);
           done({}, "", quality_json());
-        } else if constexpr (std::is_same_v<T, DryerAim>) {
+        } else if constexpr (std::is_same_v<T, DryerAim> || std::is_same_v<T, SubstanceDrop>) {
+          // The surface point under the pixel of the last frame, then the simulation's part.
           const auto hit = renderer_.pick(c.x, c.y);
           if (!hit)
             done(ErrorCode::NotFound,
                  type + ": no surface under pixel (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ")",
                  Json::object());
-          else
+          else if constexpr (std::is_same_v<T, DryerAim>)
             session_.aim_dryer(c.dryer, hit->hit, done);
-        } else if constexpr (std::is_same_v<T, SubstanceDrop>) {
-          const auto hit = renderer_.pick(c.x, c.y);
-          if (!hit)
-            done(ErrorCode::NotFound,
-                 type + ": no surface under pixel (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ")",
-                 Json::object());
           else
             session_.drop_substance(c.substance, c.amount, hit->hit, done);
         } else {

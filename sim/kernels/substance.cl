@@ -104,6 +104,18 @@ float2 lanes_compensated(floatV hi, floatV lo) {
   const floatV dz = THAW_WRAP((pi).z - vloadV(0, Z + (j)), (period).z); \
   const floatV r2 = dx * dx + dy * dy + dz * dz;
 
+/* A walk's start for particle i: the support, the periodic lengths, the reorder's position blocks X, Y, Z,
+ * the carriers' masses M, and i's position and cell. */
+#define WALK_START                                                          \
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;                  \
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f); \
+  global const float* X = soa;                                              \
+  global const float* Y = soa + stride;                                     \
+  global const float* Z = soa + 2 * stride;                                 \
+  global const float* M = sub + SUB_M * stride;                             \
+  const float4 pi = pos[i];                                                 \
+  const int4 cell = grid_cell(g, pi);
+
 /* hi, lo += d on every lane, compensated (Knuth's two-sum). */
 #define ACCUMULATE(hi, lo, d)                  \
   {                                            \
@@ -251,14 +263,7 @@ kernel void substance_norm(global const float4* pos, global const float* soa, gl
     sub[SUB_MOM * stride + i] = 0.0f;
     return;
   }
-  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
-  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
-  global const float* M = sub + SUB_M * stride;
-  const float4 pi = pos[i];
-  const int4 cell = grid_cell(g, pi);
+  WALK_START
   global const float* AS = sub + SUB_AS * stride;
   global const float* PX = sub + SUB_PX * stride;
   global const float* PY = sub + (SUB_PX + 1) * stride;
@@ -302,14 +307,7 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
   const uint i = get_global_id(0);
   if (i >= P.n || phase[i] != THAW_PHASE_ICE) return;
   const uint stride = P.stride;
-  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
-  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
-  global const float* M = sub + SUB_M * stride;
-  const float4 pi = pos[i];
-  const int4 cell = grid_cell(g, pi);
+  WALK_START
   floatV sw = (floatV)(0.0f), sww = (floatV)(0.0f), sd = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
@@ -387,21 +385,14 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uint stride = P.stride;
-  global const float* M = sub + SUB_M * stride;
-  global const float* A = sub + SUB_A * stride;
-  const float mi = M[i];
+  const float mi = sub[SUB_M * stride + i];
   if (mi == 0.0f) return;
+  WALK_START
+  global const float* A = sub + SUB_A * stride;
   const int giving = mi < 0.0f;
-  const float ai = A[i];
-  const float H = P.support, H2 = H * H, inv_H = 1.0f / H, eta2 = P.eta2;
-  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
+  const float ai = A[i], eta2 = P.eta2;
   const float unit = THAW_SIGMA(H) * inv_H * inv_H; /* x . grad W = sigma / H^2 grad_shape(q) r^2 */
   const float c[4] = {P.step0 * unit, P.step1 * unit, P.step2 * unit, P.step3 * unit};
-  global const float* X = soa;
-  global const float* Y = soa + stride;
-  global const float* Z = soa + 2 * stride;
-  const float4 pi = pos[i];
-  const int4 cell = grid_cell(g, pi);
   float wi[THAW_NSUB];
   floatV hi[THAW_NSUB], lo[THAW_NSUB];
   for (int s = 0; s < THAW_NSUB; ++s) {
