@@ -161,8 +161,7 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   if (!surface_) return;
   // Surface particles: more than a twentieth of a lattice face of area (kSurfaceMinArea; brackbill1992 gates
   // the area to the outer layer, where a flat face's particles carry 0.6 of theirs). The surface point of
-  // each lies half a spacing out along its normal: a body sampled on a lattice ends half a spacing past its
-  // outer particles.
+  // each lies surface_depth_spacings out along its normal (substance_stage.h says why a quarter).
   const double dx = scene.spacing;
   params_.min_area = static_cast<float>(kSurfaceMinArea * dx * dx);
   params_.surface_depth = static_cast<float>(surface_depth_spacings * dx);
@@ -171,7 +170,7 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   const double H = k.support;
   const double sigma2 = scene.solver.kernel == KernelFunction::WendlandC2 ? 7.0 / M_PI : 40.0 / (7.0 * M_PI);
   params_.sigma2 = static_cast<float>(sigma2);
-  sigma2_over_h2_ = sigma2 / (H * H * H * H);
+  sigma2_over_h4_ = sigma2 / (H * H * H * H);
   rest_density_ = k.rest_density;
   for (std::size_t s = 0; s < count; ++s) {
     const Substance& sub = scene.substances[s];
@@ -255,7 +254,7 @@ void SubstanceStage::diffuse(double dt, const NeighbourView& nv) {
       *adsorb[s] = static_cast<float>(sub.adsorption_rate * rest_density_ * dt);
       *desorb[s] = static_cast<float>(sub.desorption_rate * dt);
       *inv_capacity[s] = sub.surface_capacity > 0 ? static_cast<float>(1.0 / sub.surface_capacity) : 0.0f;
-      *glide[s] = static_cast<float>(2.0 * sub.surface_diffusivity * dt * sigma2_over_h2_);
+      *glide[s] = static_cast<float>(2.0 * sub.surface_diffusivity * dt * sigma2_over_h4_);
     }
   }
   set_args(k_diffuse_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_, amount(0),

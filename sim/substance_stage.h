@@ -34,7 +34,10 @@ FieldSpec adsorbed_field(const std::string& name);
 // A water particle with more surface area than this many spacings squared is a surface particle and holds
 // surface-active substances on the surface; one with less hands them to its bulk.
 inline constexpr double kSurfaceMinArea = 0.05;
-// Where a surface particle's point on the surface lies: this many spacings out along its normal.
+// Where a surface particle's point on the surface lies: this many spacings out along its normal. A flat
+// face's outer layer lies half a spacing inside its surface, a lattice sphere's outer particles anywhere
+// from 0 to 1 spacing; on surface-diffusion, half a spacing made the decay 5-7 % slow, none 2-8 % fast,
+// a quarter within 3 % from res 6 to 20 (docs/SUBSTANCES.md). Measured, not derived.
 inline constexpr double surface_depth_spacings = 0.25;
 // Whether some substance of the scene is surface-active: then the solver builds the surface stage for it.
 bool substances_need_surface(const Scene& scene);
@@ -110,7 +113,7 @@ class SubstanceStage {
   // Surface-active substances (THAW_SURFACE): their adsorbed fields by substance (-1: none), the surface
   // stage's fields, and each one's rates [1/s, m/s] for the step's constants.
   bool surface_ = false;
-  double sigma2_over_h2_ = 0, rest_density_ = 0;
+  double sigma2_over_h4_ = 0, rest_density_ = 0;
   std::vector<int> adsorbed_;
   std::vector<ParticleStore::Field> adsorbed_fields_;
   SurfaceFields surface_fields_;
