@@ -56,6 +56,15 @@
 #define SUB_NX (SUB_AS + 6)
 #define SUB_G (SUB_AS + 9)
 
+/* The surface points' and normals' blocks, for SURFACE_PAIR. */
+#define SURFACE_POINTS                                      \
+  global const float* PX = sub + SUB_PX * stride;           \
+  global const float* PY = sub + (SUB_PX + 1) * stride;     \
+  global const float* PZ = sub + (SUB_PX + 2) * stride;     \
+  global const float* NX = sub + SUB_NX * stride;           \
+  global const float* NY = sub + (SUB_NX + 1) * stride;     \
+  global const float* NZ = sub + (SUB_NX + 2) * stride;
+
 /* Inside a walk, with point_i, normal_i and the PX.. and NX.. blocks in scope: p2, the squared distance
  * between the surface points of i and the lanes j.. along the surface, their offset less its part along the
  * pair's mean normal n_i + n_j. The surface points of a lattice's jagged outer layer lie up to half a spacing
@@ -265,12 +274,7 @@ kernel void substance_norm(global const float4* pos, global const float* soa, gl
   }
   WALK_START
   global const float* AS = sub + SUB_AS * stride;
-  global const float* PX = sub + SUB_PX * stride;
-  global const float* PY = sub + (SUB_PX + 1) * stride;
-  global const float* PZ = sub + (SUB_PX + 2) * stride;
-  global const float* NX = sub + SUB_NX * stride;
-  global const float* NY = sub + (SUB_NX + 1) * stride;
-  global const float* NZ = sub + (SUB_NX + 2) * stride;
+  SURFACE_POINTS
   const float3 point_i = (float3)(PX[i], PY[i], PZ[i]), normal_i = (float3)(NX[i], NY[i], NZ[i]);
   floatV sw = (floatV)(0.0f), sm = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
@@ -403,12 +407,7 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
 #ifdef THAW_SURFACE
   global const float* AS = sub + SUB_AS * stride;
   global const float* NRM = sub + SUB_NRM * stride;
-  global const float* PX = sub + SUB_PX * stride;
-  global const float* PY = sub + (SUB_PX + 1) * stride;
-  global const float* PZ = sub + (SUB_PX + 2) * stride;
-  global const float* NX = sub + SUB_NX * stride;
-  global const float* NY = sub + (SUB_NX + 1) * stride;
-  global const float* NZ = sub + (SUB_NX + 2) * stride;
+  SURFACE_POINTS
   const float adsorb[4] = {P.adsorb0, P.adsorb1, P.adsorb2, P.adsorb3};
   const float desorb[4] = {P.desorb0, P.desorb1, P.desorb2, P.desorb3};
   const float inv_capacity[4] = {P.inv_capacity0, P.inv_capacity1, P.inv_capacity2, P.inv_capacity3};

@@ -62,8 +62,8 @@ TEST_F(KernelBuild, MissingEmbeddedFileIsNamed) {
 }
 
 TEST_F(KernelBuild, EveryEmbeddedStageBuilds) {
-  for (const char* stage :
-       {"grid.cl", "boundary.cl", "density.cl", "forces.cl", "integrate.cl", "step_limits.cl", "heat.cl", "dfsph.cl"})
+  for (const char* stage : {"grid.cl", "boundary.cl", "density.cl", "forces.cl", "integrate.cl",
+                            "step_limits.cl", "heat.cl", "dfsph.cl"})
     EXPECT_NO_THROW(
         cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h", "dryer_model.h",
                     "heat_params.h", "fluid_params.h", "dfsph_columns.h", "wrapped_walk.h", stage},
@@ -126,6 +126,9 @@ TEST_F(KernelBuild, EveryProgramIsPortableOpenClC) {
   variants.push_back({"dam-break", {"solver.kernel=wendland_c2", "solver.support_ratio=3"}});
   variants.push_back(
       {"ice-on-plate", {"domain.walls=[]", "solver.flow=false", "solver.periodic=[\"x\",\"y\"]"}});
+  // A surface-active substance beside a salt that lowers the melting point (substance.cl's THAW_SURFACE with
+  // THAW_MELT_SHIFT and THAW_REJECT).
+  variants.push_back({"salt-on-ice", {"substances.dye={\"kind\": \"surface_active\"}"}});
   // Tension, both models, beside free ice (rigid.cl takes the adhesion's reaction).
   variants.push_back({"default", {"tension.model=akinci2013"}});
   variants.push_back({"default", {"tension.model=iwasaki2010", "solver.pressure=dfsph"}});
