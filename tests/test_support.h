@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +20,7 @@
 #include "sim/error.h"
 #include "sim/scene.h"
 #include "sim/state_file.h"
+#include "sim/validation/case.h"
 
 namespace thaw::testing {
 
@@ -127,6 +129,15 @@ inline std::string scene_error_path(Json doc) {
     return e.path();
   }
   return "(no error)";
+}
+
+// Prints a validation case's metrics and expects every one within its gate, naming any that is not.
+inline void expect_case_passes(const CaseResult& r) {
+  for (const auto& [key, m] : r.metrics) {
+    std::printf("[ info ] %s %.5g (reference %.5g, error %.4g, gate %.3g)\n", key.c_str(), m.value,
+                m.reference, m.error, m.gate);
+    EXPECT_TRUE(m.passed()) << key << ": error " << m.error << " against the gate " << m.gate;
+  }
 }
 
 }  // namespace thaw::testing

@@ -78,6 +78,35 @@ double slope_through_origin(const std::vector<double>& t, const std::vector<doub
   return tt > 0 ? ty / tt : 0.0;
 }
 
+// Steps `solver` to t_end, stopping at `samples` even times to call at(time); returns the wall seconds spent
+// stepping (the measurements between are not the model's cost).
+template <class F>
+double run_sampled(Solver& solver, double t_end, int samples, F at) {
+  double wall = 0;
+  for (int n = 1; n <= samples; ++n) {
+    const auto w0 = std::chrono::steady_clock::now();
+    while (solver.time() < t_end * n / samples * (1.0 - 1e-12)) solver.step();
+    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    at(solver.time());
+  }
+  return wall;
+}
+
+// The case's result: the run's size, steps and wall time, its own metrics, then the substance's closure
+// (its total now against the start's) relative to the start's.
+CaseResult result_of(const Solver& solver, double wall,
+                     std::vector<std::pair<std::string, MetricResult>> metrics, const Json& prm) {
+  CaseResult r;
+  r.particles = solver.size();
+  r.steps = solver.steps();
+  r.wall_s = wall;
+  r.metrics = std::move(metrics);
+  const double initial = solver.substance_books().initial.at(0);
+  const double closure = solver.substance_totals().at(0) - initial;
+  r.metrics.push_back({"closure", {closure, 0.0, std::abs(closure) / initial, prm["closure_gate"]}});
+  return r;
+}
+
 Field adsorption_params() {
   return sphere_params({
       number("concentration", "c0, the dissolved concentration at the start").in("kg/m^3").def(1.0).above(0),
@@ -126,34 +155,19 @@ CaseResult run_adsorption(ClRuntime& cl, const Json& prm, int res) {
     return S;
   };
 
-  const double t_end = double(prm["duration"]) / k;
-  const int samples = prm["samples"];
   std::vector<double> t, y;
   double worst = 0;
-  double wall = 0;
-  for (int n = 1; n <= samples; ++n) {
-    const double until = t_end * n / samples;
-    const auto w0 = std::chrono::steady_clock::now();
-    while (solver.time() < until * (1.0 - 1e-12)) solver.step();
-    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-    const double S = on_surface(), time = solver.time();
+  const double wall = run_sampled(solver, double(prm["duration"]) / k, prm["samples"], [&](double time) {
+    const double S = on_surface();
     worst = std::max(worst, std::abs(S - S_eq * (1.0 - std::exp(-k * time))) / S_eq);
     t.push_back(time);
     y.push_back(-std::log(std::max(1.0 - S / S_eq, 1e-300)));
-  }
+  });
   const double k_fit = slope_through_origin(t, y);
-  const double closure = solver.substance_totals().at(0) - solver.substance_books().initial.at(0);
-
-  CaseResult r;
-  r.particles = solver.size();
-  r.steps = solver.steps();
-  r.wall_s = wall;
-  r.metrics = {
-      {"rate", {k_fit, k, std::abs(k_fit - k) / k, prm["rate_gate"]}},
-      {"surface_amount", {worst, 0.0, worst, prm["amount_gate"]}},
-      {"closure", {closure, 0.0, std::abs(closure) / N, prm["closure_gate"]}},
-  };
-  return r;
+  return result_of(solver, wall,
+                   {{"rate", {k_fit, k, std::abs(k_fit - k) / k, prm["rate_gate"]}},
+                    {"surface_amount", {worst, 0.0, worst, prm["amount_gate"]}}},
+                   prm);
 }
 
 Field surface_diffusion_params() {
@@ -218,30 +232,15 @@ CaseResult run_surface_diffusion(ClRuntime& cl, const Json& prm, int res) {
     return acc > 0 ? sc / acc : 0.0;
   };
   const double rate = 2.0 * Ds / (R * R);
-  const double t_end = double(prm["decay"]) / rate;
-  const int samples = prm["samples"];
   const double a0 = amplitude();
   std::vector<double> t, y;
-  double wall = 0;
-  for (int n = 1; n <= samples; ++n) {
-    const auto w0 = std::chrono::steady_clock::now();
-    while (solver.time() < t_end * n / samples * (1.0 - 1e-12)) solver.step();
-    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-    t.push_back(solver.time());
+  const double wall = run_sampled(solver, double(prm["decay"]) / rate, prm["samples"], [&](double time) {
+    t.push_back(time);
     y.push_back(-std::log(std::max(amplitude() / a0, 1e-300)));
-  }
+  });
   const double fitted = slope_through_origin(t, y);
-  const double total = solver.substance_totals().at(0), initial = solver.substance_books().initial.at(0);
-
-  CaseResult r;
-  r.particles = solver.size();
-  r.steps = solver.steps();
-  r.wall_s = wall;
-  r.metrics = {
-      {"decay_rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}},
-      {"closure", {total - initial, 0.0, std::abs(total - initial) / initial, prm["closure_gate"]}},
-  };
-  return r;
+  return result_of(solver, wall,
+                   {{"decay_rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}}}, prm);
 }
 
 }  // namespace

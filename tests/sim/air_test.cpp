@@ -22,6 +22,7 @@ namespace thaw {
 namespace {
 
 using testing::ClSuite;
+using testing::expect_case_passes;
 
 constexpr auto kAir = static_cast<std::uint8_t>(Phase::Air);
 
@@ -229,14 +230,6 @@ TEST(AirScene, IdealGasAirIsMultiphaseAndNamesWhatItNeeds) {
 }
 
 class AirTest : public ClSuite {};
-
-// Prints a validation case's metrics and expects every one within its gate.
-void expect_case_passes(const CaseResult& r) {
-  for (const auto& [key, m] : r.metrics)
-    std::printf("[ info ] %s %.5g (reference %.5g, error %.4g, gate %.3g)\n", key.c_str(), m.value,
-                m.reference, m.error, m.gate);
-  EXPECT_TRUE(r.passed());
-}
 
 // Air beside water of another rest density needs DFSPH's multiphase form (solver.multiphase): WCSPH, which
 // has one rest density, is refused by name; DFSPH runs them, and the air above the water keeps its mass.
