@@ -121,6 +121,17 @@ std::vector<VtkArray> point_data(const HostParticles& p, const std::vector<std::
     }
     arrays.push_back(std::move(a));
   }
+  // Coatings on solids and ice: each boundary particle's deposit [kg] (over the spacing squared, the deposit
+  // per area).
+  for (const HostColumn& c : p.columns) {
+    if (c.spec.name.rfind(kDepositedPrefix, 0) != 0 || c.spec.width != 2 || c.size() != p.size()) continue;
+    VtkArray a{c.spec.name, "Float32", 1, {}};
+    a.bytes.reserve(4 * n);
+    const Float2* q = c.as<Float2>();
+    for (std::size_t i : order)
+      put_little_endian(a.bytes, static_cast<float>(double(q[i][0]) + double(q[i][1])));
+    arrays.push_back(std::move(a));
+  }
   // Every field a stage declared as exported (sim/particle_fields.h), element by element in id order.
   for (const HostColumn& c : p.columns) {
     if (!c.spec.exported || c.size() != p.size()) continue;

@@ -55,7 +55,11 @@ const char* name(KernelFunction k) {
 const char* name(Eos e) { return e == Eos::Tait ? "tait" : "linear"; }
 const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph" : "wcsph"; }
 const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
-const char* name(SubstanceKind k) { return k == SubstanceKind::SurfaceActive ? "surface_active" : "bulk"; }
+const char* name(SubstanceKind k) {
+  return k == SubstanceKind::SurfaceActive ? "surface_active"
+         : k == SubstanceKind::Coating     ? "coating"
+                                           : "bulk";
+}
 const char* name(ExposedArea a) {
   switch (a) {
     case ExposedArea::Orthmann2013:
@@ -435,6 +439,18 @@ Solid solid_from_json(Json& j, const std::string& path, const Scene& s, const Js
     solid.normal = unit_direction(vec(j["normal"]), path + ".normal");
   }
   solid.temperature = temperature_or(j, s.heat.ambient_temperature);
+  solid.deposits.assign(s.substances.size(), 0.0);
+  for (const auto& [name, value] : j["deposits"].items()) {
+    const std::string at = path + ".deposits." + name;
+    const auto it = std::find_if(s.substances.begin(), s.substances.end(),
+                                 [&](const Substance& d) { return d.name == name; });
+    if (it == s.substances.end())
+      throw SceneError(at, "the scene's `substances` declare no substance of this name");
+    if (!it->coating())
+      throw SceneError(at, "only a coating sticks to a solid: substance '" + name + "' is of kind " +
+                               thaw::name(it->kind));
+    solid.deposits[static_cast<std::size_t>(it - s.substances.begin())] = value["deposit"].get<double>();
+  }
   return solid;
 }
 
@@ -510,14 +526,39 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     sub.molar_mass = d["molar_mass"].get<double>();
     sub.dissociation = d["dissociation"].get<double>();
     sub.enters_ice = d["enters_ice"].get<bool>();
-    sub.kind = choice_of<SubstanceKind>(d["kind"], {SubstanceKind::Bulk, SubstanceKind::SurfaceActive});
+    sub.kind = choice_of<SubstanceKind>(
+        d["kind"], {SubstanceKind::Bulk, SubstanceKind::SurfaceActive, SubstanceKind::Coating});
     if (sub.surface_active()) {
       sub.surface_diffusivity = d["surface_diffusivity"].get<double>();
       sub.adsorption_rate = d["adsorption_rate"].get<double>();
       sub.desorption_rate = d["desorption_rate"].get<double>();
       sub.surface_capacity = d["surface_capacity"].get<double>();
     }
+    if (sub.coating()) {
+      sub.coating_rate = d["coating_rate"].get<double>();
+      sub.coating_capacity = d["coating_capacity"].get<double>();
+      sub.cleansing_rate = d["cleansing_rate"].get<double>();
+    }
     s.substances.push_back(sub);
+  }
+  // A coating's cleanser: another of the scene's substances.
+  for (Substance& sub : s.substances) {
+    if (!sub.coating()) continue;
+    const std::string by = doc["substances"][sub.name]["cleansed_by"].get<std::string>();
+    const std::string path = "substances." + sub.name + ".cleansed_by";
+    if (by.empty()) {
+      if (sub.cleansing_rate > 0)
+        throw SceneError("substances." + sub.name + ".cleansing_rate",
+                         "cleansing needs a cleanser: name the substance in cleansed_by");
+      continue;
+    }
+    const auto it = std::find_if(s.substances.begin(), s.substances.end(),
+                                 [&](const Substance& d) { return d.name == by; });
+    if (it == s.substances.end() || &*it == &sub)
+      throw SceneError(path, it == s.substances.end()
+                                 ? "the scene's `substances` declare no substance '" + by + "'"
+                                 : "a coating cannot cleanse itself");
+    sub.cleanser = static_cast<int>(it - s.substances.begin());
   }
   s.camera = camera_from_json(doc["camera"]);
 

@@ -38,7 +38,7 @@ enum class BoundaryVolume { Lattice, Akinci2012 };
 enum class DfsphBoundary { Adami2012, Akinci2012 };
 // How fluids of several rest densities meet (dfsph, sim/kernels/dfsph.cl).
 enum class Multiphase { HuAdams2006, DomaradzkiMartyn };
-enum class SubstanceKind { Bulk, SurfaceActive };
+enum class SubstanceKind { Bulk, SurfaceActive, Coating };
 enum class ExposedArea { Iwasaki2010, Orthmann2013, Brackbill1992 };
 // Interfacial tension (sim/tension_stage.h): none, Akinci et al. 2013's cohesion, curvature and adhesion, or
 // Iwasaki et al. 2010's eq. 4.
@@ -55,7 +55,7 @@ const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
 const char* name(Eos e);             // "tait", "linear"
 const char* name(PressureSolver p);  // "wcsph", "dfsph"
 const char* name(BoundaryVolume b);  // "lattice", "akinci"
-const char* name(SubstanceKind k);   // "bulk", "surface_active"
+const char* name(SubstanceKind k);   // "bulk", "surface_active", "coating"
 const char* name(ExposedArea a);     // "iwasaki2010", "orthmann2013", "brackbill1992"
 const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
 const char* name(Multiphase m);      // "hu_adams2006", "domaradzki_martyn"
@@ -141,6 +141,15 @@ struct Substance {
   double desorption_rate = 0.1;       // k_d [1/s]
   double surface_capacity = 1.2e-6;   // Gamma_max [kg/m^2]; 0: unlimited (Henry's law)
   bool surface_active() const { return kind == SubstanceKind::SurfaceActive; }
+  // A coating (Orthmann et al. 2013 sec. 6.3-6.4: paint, dye that stains, grease) also sticks to the solids
+  // and ice the water touches, an amount per boundary particle over its face (a deposit Gamma_R [kg/m^2]):
+  // dGamma_R/dt = k_c c (1 - Gamma_R / Gamma_R,max) - k_r c_D Gamma_R, c its concentration in the water
+  // there and c_D that of the substance that cleanses it (a detergent), which takes it back into the water.
+  double coating_rate = 1e-5;      // k_c, the deposition velocity [m/s]
+  double coating_capacity = 1e-4;  // Gamma_R,max [kg/m^2]; 0: unlimited
+  int cleanser = -1;               // index of the substance that cleanses it; -1: none
+  double cleansing_rate = 0.0;     // k_r [m^3/(kg s)]
+  bool coating() const { return kind == SubstanceKind::Coating; }
 };
 inline constexpr int kMaxSubstances = 4;  // per scene: the stage walks the neighbours once for all of them
 
@@ -171,6 +180,9 @@ struct Solid {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();    // plane: a point on the surface
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // plane: unit, points into the fluid
   double temperature = 20.0;                          // initial, or held [°C]
+  // The deposit of each of Scene::substances on its outer layer at the start [kg/m^2] (coatings only: a
+  // dirty plate's grease).
+  std::vector<double> deposits;
 };
 
 struct Lamp {

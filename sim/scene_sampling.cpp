@@ -1,7 +1,11 @@
 // Turning a scene into particles: fluid and ice on a lattice, solids and walls as boundary particles, each
 // with the enthalpy of its initial temperature.
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <set>
+#include <utility>
 
 #include "sim/emitters.h"
 #include "sim/error.h"
@@ -112,12 +116,25 @@ HostParticles sample_scene(const Scene& scene) {
   const int layers = wall_layer_count(scene);
   const double depth = layers * dx;
 
-  // Boundary particles first; their mass (Psi) is left 0 for the solver to compute.
-  for (const auto& s : scene.solids) {
+  // Boundary particles first; their mass (Psi) is left 0 for the solver to compute. Those of a solid's outer
+  // layer, where it has deposits, by solid.
+  std::vector<std::pair<std::size_t, std::size_t>> outer;  // (particle, solid)
+  for (std::size_t si = 0; si < scene.solids.size(); ++si) {
+    const auto& s = scene.solids[si];
     const double h_solid = enthalpy_at(scene, s.material, s.temperature);
+    const bool dirty = std::any_of(s.deposits.begin(), s.deposits.end(), [](double d) { return d > 0; });
     if (!s.plane) {
-      for (const Vec3& x : voxelize_shell(s.shape, dx, layers, &scene.domain.min))
+      std::set<std::array<long long, 3>> skin;  // the outer layer's lattice points
+      auto key = [&](const Vec3& x) {
+        const Vec3 k = (x - scene.domain.min) / dx;
+        return std::array<long long, 3>{std::llround(k.x()), std::llround(k.y()), std::llround(k.z())};
+      };
+      if (dirty)
+        for (const Vec3& x : voxelize_shell(s.shape, dx, 1, &scene.domain.min)) skin.insert(key(x));
+      for (const Vec3& x : voxelize_shell(s.shape, dx, layers, &scene.domain.min)) {
+        if (dirty && skin.count(key(x))) outer.emplace_back(p.size(), si);
         add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
+      }
     } else {
       // Layers behind the plane, clipped to the domain grown by the layer depth; along a periodic axis
       // to one period [min, max), which its neighbours see repeated.
@@ -137,7 +154,9 @@ HostParticles sample_scene(const Scene& scene) {
         for (double b = std::floor(vmin / dx) * dx; b <= vmax; b += dx)
           for (int k = 0; k < layers; ++k) {
             const Vec3 x = s.point + (a + 0.5 * dx) * u + (b + 0.5 * dx) * v - (k + 0.5) * dx * nrm;
-            if (inside(period, x)) add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
+            if (!inside(period, x)) continue;
+            if (dirty && k == 0) outer.emplace_back(p.size(), si);
+            add(p, x, Vec3::Zero(), 0.f, Phase::Solid, s.material, h_solid);
           }
     }
   }
@@ -221,6 +240,7 @@ HostParticles sample_scene(const Scene& scene) {
     std::vector<std::vector<double>> concentrations;
     for (const FluidBlock& f : scene.fluids) concentrations.push_back(f.substances);
     add_substance_columns(p, scene, first_of, concentrations);
+    add_deposit_columns(p, scene, outer);
   }
   return p;
 }

@@ -460,11 +460,38 @@ const Field& scene_schema() {
                        "Whether water that freezes keeps it; false (salt, dye): the freezing water gives "
                        "it up to the water around it")
                       .def(false),
-                  choice("kind", {"bulk", "surface_active"},
+                  choice("kind", {"bulk", "surface_active", "coating"},
                          "bulk: it stays dissolved in the water; surface_active (a detergent): it also "
                          "gathers on the water's free surface, adsorbing from and desorbing to the water "
-                         "under it and diffusing along the surface (Orthmann et al. 2013 sec. 5-6.2)")
+                         "under it and diffusing along the surface (Orthmann et al. 2013 sec. 5-6.2); "
+                         "coating (paint, a staining dye, grease): it also sticks to the solids and ice "
+                         "the water touches, and a cleanser takes it back (sec. 6.3-6.4)")
                       .def("bulk"),
+                  number("coating_rate",
+                         "k_c in dGamma_R/dt = k_c c (1 - Gamma_R / Gamma_R,max) - k_r c_D Gamma_R: the "
+                         "speed at which it deposits from the water onto a solid or ice surface")
+                      .in("m/s")
+                      .def(1e-5)
+                      .at_least(0)
+                      .at_most(1)
+                      .when("kind", "coating"),
+                  number("coating_capacity", "Gamma_R,max, the most that sticks per area; 0: no limit")
+                      .in("kg/m^2")
+                      .def(1e-4)
+                      .at_least(0)
+                      .at_most(1)
+                      .when("kind", "coating"),
+                  text("cleansed_by",
+                       "The substance (a detergent) whose concentration c_D in the water takes the deposit "
+                       "back into the water; empty: none")
+                      .def("")
+                      .when("kind", "coating"),
+                  number("cleansing_rate", "k_r, the rate of cleansing per concentration of the cleanser")
+                      .in("m^3/(kg s)")
+                      .def(0.0)
+                      .at_least(0)
+                      .at_most(1e6)
+                      .when("kind", "coating"),
                   number("surface_diffusivity", "Its diffusivity D_s along the free surface")
                       .in("m^2/s")
                       .def(1e-9)
@@ -689,6 +716,16 @@ const Field& scene_schema() {
                            "Hold the solid at its temperature, like a heater or a cooling plate; the heat "
                            "that takes is reported as `held` in the energy budget")
                           .def(false),
+                      map_of("deposits", "<substance>",
+                             {
+                                 number("deposit", "Mass of it per area of the solid's surface")
+                                     .in("kg/m^2")
+                                     .at_least(0)
+                                     .at_most(1),
+                             },
+                             "What sticks to its surface at the start (a dirty plate's grease), by the name "
+                             "the scene's `substances` gives a coating")
+                          .def(Json::object()),
                   }),
               "Static solids, sampled as boundary particles as deep as the kernel reaches; they conduct "
               "heat.")

@@ -20,6 +20,33 @@ FieldSpec adsorbed_field(const std::string& name) {
   return {kAdsorbedPrefix + name, FieldType::Float32, 2, true, false};
 }
 
+FieldSpec deposited_field(const std::string& name) {
+  return {kDepositedPrefix + name, FieldType::Float32, 2, true, false};
+}
+
+bool substances_coat(const Scene& scene) {
+  return std::any_of(scene.substances.begin(), scene.substances.end(),
+                     [](const Substance& s) { return s.coating(); });
+}
+
+void add_deposit_columns(HostParticles& p, const Scene& scene,
+                         const std::vector<std::pair<std::size_t, std::size_t>>& outer) {
+  const double face = scene.spacing * scene.spacing;
+  for (std::size_t s = 0; s < scene.substances.size(); ++s) {
+    if (!scene.substances[s].coating()) continue;
+    HostColumn c{deposited_field(scene.substances[s].name), {}};
+    c.bytes.assign(p.size() * c.spec.bytes(), 0);
+    Float2* d = c.as<Float2>();
+    for (const auto& [i, solid] : outer) {
+      const std::vector<double>& deposits = scene.solids[solid].deposits;
+      const double amount = s < deposits.size() ? deposits[s] * face : 0.0;
+      const float hi = static_cast<float>(amount);
+      d[i] = {hi, static_cast<float>(amount - double(hi))};
+    }
+    p.columns.push_back(std::move(c));
+  }
+}
+
 bool substances_need_surface(const Scene& scene) {
   return std::any_of(scene.substances.begin(), scene.substances.end(),
                      [](const Substance& s) { return s.surface_active(); });
@@ -89,8 +116,14 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
       adsorbed_.back() = static_cast<int>(adsorbed_fields_.size());
       adsorbed_fields_.push_back(store.add(adsorbed_field(s.name)));
     }
+    deposited_.push_back(-1);
+    if (s.coating()) {
+      deposited_.back() = static_cast<int>(deposited_fields_.size());
+      deposited_fields_.push_back(store.add(deposited_field(s.name)));
+    }
   }
   surface_ = !adsorbed_fields_.empty();
+  deposit_ = !deposited_fields_.empty();
   if (surface_) surface_fields_ = *surface;
   // The shift is a field wherever the scene's substances lower the melting point (a state file keeps it for
   // the temperatures it shows), and renewed here only where heat reads it.
@@ -102,6 +135,7 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   if (lowers_) opts += " -DTHAW_MELT_SHIFT";
   if (rejects) opts += " -DTHAW_REJECT";
   if (surface_) opts += " -DTHAW_SURFACE";
+  if (deposit_) opts += " -DTHAW_DEPOSIT";
   ice_pass_ = lowers_ || rejects;
   if (enthalpy) enthalpy_ = *enthalpy;
   for (int a = 0; a < 3; ++a)
@@ -114,12 +148,14 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   if (ice_pass_) k_ice_ = cl::Kernel(program, "substance_ice");
   k_diffuse_ = cl::Kernel(program, "substance_diffuse");
   if (surface_) k_norm_ = cl::Kernel(program, "substance_norm");
+  if (deposit_) k_wet_ = cl::Kernel(program, "substance_wet");
 
   // Zeros past the particles too: the walk's lanes read a few floats beyond each cell's last one. The
   // blocks: M, A, W per substance; with surface-active ones AS, NRM, MOM, PX, PY, PZ, NX, NY, NZ, G per
-  // substance.
+  // substance; with coatings F, R per substance.
   const std::size_t count = scene.substances.size();
-  const std::size_t bytes = std::size_t(layout.stride) * (2 + count + (surface_ ? 9 + count : 0)) * 4;
+  const std::size_t bytes =
+      std::size_t(layout.stride) * (2 + count + (surface_ ? 9 + count : 0) + (deposit_ ? 1 + count : 0)) * 4;
   sub_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, bytes);
   cl.queue().enqueueFillBuffer(sub_, 0.0f, 0, bytes);
   // Each material's rest density and cryoscopic constant (ice: that of the water it melts into).
@@ -157,6 +193,43 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   const double D = diffusivity_.empty() ? 0.0 : *std::max_element(diffusivity_.begin(), diffusivity_.end());
   const double h = k.smoothing;
   max_dt_ = D > 0 ? scene.solver.diffusion_number * h * h / D : std::numeric_limits<double>::infinity();
+  rest_density_ = k.rest_density;
+
+  if (deposit_) {
+    const double dx = scene.spacing, H = k.support;
+    params_.face = static_cast<float>(dx * dx);
+    // The water weight sum_j M_j w(r / H) of a kernel volume kWetFraction full of water: rho0 kWetFraction
+    // over the kernel's normalisation sigma / H^3 (Wendland C2 21 / (2 pi), the cubic spline 8 / pi).
+    const double sigma3 =
+        scene.solver.kernel == KernelFunction::WendlandC2 ? 21.0 / (2.0 * M_PI) : 8.0 / M_PI;
+    params_.wet_weight = static_cast<float>(kWetFraction * k.rest_density * H * H * H / sigma3);
+    params_.cleanser = 0xffffu;
+    for (std::size_t s = 0; s < count; ++s) {
+      const Substance& sub = scene.substances[s];
+      if (!sub.coating()) continue;
+      params_.coating |= 1u << s;
+      if (sub.cleanser >= 0) {
+        params_.cleanser &= ~(15u << (4 * s));
+        params_.cleanser |= static_cast<unsigned>(sub.cleanser) << (4 * s);
+      }
+      // A step may move at most diffusion_number of a carrier's coating to the boundary (k_c dt / dx: a
+      // carrier of volume dx^3 over a face dx^2), of a boundary's coating saturating (k_c c_max dt /
+      // Gamma_R,max) or of a deposit back (k_r c_D,max dt), c_max the largest concentration the scene starts
+      // with or pours.
+      auto most = [&](std::size_t of) {
+        double c = 0;
+        for (const FluidBlock& f : scene.fluids)
+          c = std::max(c, of < f.substances.size() ? f.substances[of] : 0.0);
+        for (const Emitter& e : scene.emitters)
+          c = std::max(c, of < e.substances.size() ? e.substances[of] : 0.0);
+        return c;
+      };
+      double rate = sub.coating_rate / dx;
+      if (sub.coating_capacity > 0) rate += sub.coating_rate * most(s) / sub.coating_capacity;
+      if (sub.cleanser >= 0) rate += sub.cleansing_rate * most(static_cast<std::size_t>(sub.cleanser));
+      if (rate > 0) max_dt_ = std::min(max_dt_, scene.solver.diffusion_number / rate);
+    }
+  }
 
   if (!surface_) return;
   // Surface particles: more than a twentieth of a lattice face of area (kSurfaceMinArea; brackbill1992 gates
@@ -171,7 +244,6 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   const double sigma2 = scene.solver.kernel == KernelFunction::WendlandC2 ? 7.0 / M_PI : 40.0 / (7.0 * M_PI);
   params_.sigma2 = static_cast<float>(sigma2);
   sigma2_over_h4_ = sigma2 / (H * H * H * H);
-  rest_density_ = k.rest_density;
   for (std::size_t s = 0; s < count; ++s) {
     const Substance& sub = scene.substances[s];
     if (adsorbed_[s] < 0) continue;
@@ -201,9 +273,16 @@ const cl::Buffer& SubstanceStage::on_surface(std::size_t s) const {
   return adsorbed_fields_.empty() ? sub_ : store_[adsorbed_fields_.front()];
 }
 
+const cl::Buffer& SubstanceStage::on_solids(std::size_t s) const {
+  if (s < deposited_.size() && deposited_[s] >= 0)
+    return store_[deposited_fields_[std::size_t(deposited_[s])]];
+  return deposited_fields_.empty() ? sub_ : store_[deposited_fields_.front()];
+}
+
 std::vector<ParticleStore::Field> SubstanceStage::amount_fields(std::size_t s) const {
   std::vector<ParticleStore::Field> out{fields_[s]};
   if (adsorbed_[s] >= 0) out.push_back(adsorbed_fields_[std::size_t(adsorbed_[s])]);
+  if (deposited_[s] >= 0) out.push_back(deposited_fields_[std::size_t(deposited_[s])]);
   return out;
 }
 
@@ -221,11 +300,17 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
   const cl::Buffer& normal = surface_ ? store_[surface_fields_.normal] : sub_;
   set_args(k_state_, store_[core_.position], store_[core_.density], enthalpy, store_[core_.phase],
            store_[core_.material], fluid_, law_, sub_, shift, amount(0), amount(1), amount(2), amount(3),
-           area, normal, on_surface(0), on_surface(1), on_surface(2), on_surface(3), params_);
+           area, normal, on_surface(0), on_surface(1), on_surface(2), on_surface(3), on_solids(0),
+           on_solids(1), on_solids(2), on_solids(3), params_);
   launch(q, k_state_, layout_.n);
   if (surface_) {
     set_args(k_norm_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_);
     launch(q, k_norm_, layout_.n);
+  }
+  if (deposit_) {
+    set_args(k_wet_, store_[core_.position], store_[core_.phase], nv.soa, sub_, nv.cell_start, nv.grid,
+             params_);
+    launch(q, k_wet_, layout_.n);
   }
   if (ice_pass_) {
     set_args(k_ice_, store_[core_.position], store_[core_.phase], store_[core_.material], fluid_, law_,
@@ -257,8 +342,22 @@ void SubstanceStage::diffuse(double dt, const NeighbourView& nv) {
       *glide[s] = static_cast<float>(2.0 * sub.surface_diffusivity * dt * sigma2_over_h4_);
     }
   }
+  if (deposit_) {
+    float* coat[4] = {&params_.coat0, &params_.coat1, &params_.coat2, &params_.coat3};
+    float* cleanse[4] = {&params_.cleanse0, &params_.cleanse1, &params_.cleanse2, &params_.cleanse3};
+    float* inv_capacity[4] = {&params_.inv_coat_capacity0, &params_.inv_coat_capacity1,
+                              &params_.inv_coat_capacity2, &params_.inv_coat_capacity3};
+    for (std::size_t s = 0; s < deposited_.size(); ++s) {
+      if (deposited_[s] < 0) continue;
+      const Substance& sub = scene_.substances[s];
+      *coat[s] = static_cast<float>(sub.coating_rate * rest_density_ * dt);
+      *cleanse[s] = sub.cleanser >= 0 ? static_cast<float>(sub.cleansing_rate * rest_density_ * dt) : 0.0f;
+      *inv_capacity[s] = sub.coating_capacity > 0 ? static_cast<float>(1.0 / sub.coating_capacity) : 0.0f;
+    }
+  }
   set_args(k_diffuse_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_, amount(0),
-           amount(1), amount(2), amount(3), on_surface(0), on_surface(1), on_surface(2), on_surface(3));
+           amount(1), amount(2), amount(3), on_surface(0), on_surface(1), on_surface(2), on_surface(3),
+           on_solids(0), on_solids(1), on_solids(2), on_solids(3));
   launch(cl_.queue(), k_diffuse_, layout_.n);
 }
 

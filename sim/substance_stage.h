@@ -30,6 +30,16 @@ FieldSpec melt_shift_field();
 // floats, hi + lo), saved; the VTU export shows it as the surface excess, amount over the particle's area.
 inline constexpr const char* kAdsorbedPrefix = "adsorbed_";
 FieldSpec adsorbed_field(const std::string& name);
+// The field of each solid or ice particle's deposit of coating `name` [kg] (two floats, hi + lo), saved; the
+// VTU export shows the amount [kg] (over the spacing squared, the deposit per area).
+inline constexpr const char* kDepositedPrefix = "deposited_";
+FieldSpec deposited_field(const std::string& name);
+// A solid or ice particle takes deposits over a face of a spacing squared once this share of its kernel's
+// volume is water; less wetted, over that share of it. The first boundary layer under a flat, lattice-
+// sampled pool has 0.128 of its volume in water (Wendland C2, support 2 spacings), the second none.
+inline constexpr double kWetFraction = 0.1;
+// Whether some substance of the scene is a coating: then boundary particles hold deposits.
+bool substances_coat(const Scene& scene);
 
 // A water particle with more surface area than this many spacings squared is a surface particle and holds
 // surface-active substances on the surface; one with less hands them to its bulk.
@@ -59,6 +69,10 @@ bool substances_rejected_by_ice(const Scene& scene);
 // particles past the ranges none. For the fluid blocks a scene samples and what its emitters pour.
 void add_substance_columns(HostParticles& p, const Scene& scene, const std::vector<std::size_t>& first_of,
                            const std::vector<std::vector<double>>& concentrations);
+// Gives the scene's coatings their deposit fields: each (particle, solid) of `outer`, the particles of a
+// solid's outer layer, that solid's deposits [kg/m^2] times the spacing squared; every other particle none.
+void add_deposit_columns(HostParticles& p, const Scene& scene,
+                         const std::vector<std::pair<std::size_t, std::size_t>>& outer);
 
 class SubstanceStage {
  public:
@@ -72,8 +86,8 @@ class SubstanceStage {
 
   // The amount field of each of the scene's substances, in its order.
   const std::vector<ParticleStore::Field>& fields() const { return fields_; }
-  // The fields that hold substance s, which all count to its total: its amount in the bulk, and on the
-  // surface for a surface-active one.
+  // The fields that hold substance s, which all count to its total: its amount in the bulk, on the surface
+  // for a surface-active one, and on solids and ice for a coating.
   std::vector<ParticleStore::Field> amount_fields(std::size_t s) const;
 
   // The diffusion's limit on dt [s]: solver.diffusion_number h^2 / D of the fastest substance.
@@ -119,6 +133,12 @@ class SubstanceStage {
   SurfaceFields surface_fields_;
   cl::Kernel k_norm_;
   const cl::Buffer& on_surface(std::size_t s) const;  // substance s's adsorbed field, or any past the last
+  // Coatings (THAW_DEPOSIT): their deposit fields by substance (-1: none).
+  bool deposit_ = false;
+  std::vector<int> deposited_;
+  std::vector<ParticleStore::Field> deposited_fields_;
+  cl::Kernel k_wet_;
+  const cl::Buffer& on_solids(std::size_t s) const;  // substance s's deposit field, or any past the last
   cl::Buffer sub_, fluid_, law_;
   const cl::Buffer& amount(std::size_t s) const;  // substance s's field, or the first's past the last
 };

@@ -80,6 +80,20 @@
   const floatV p2 = fmax(ox * ox + oy * oy + oz * oz - select((floatV)(0.0f), on * on / nn, nn > 0.0f), 0.0f);
 #endif
 
+#ifdef THAW_DEPOSIT
+/* With coatings, after the blocks above:
+ *   F     a solid or ice particle's face over its wet weight, face / max(sum_j M_j w(r_ij / H), wet_weight)
+ *         over the carriers j within its support (substance_wet); 0 for every other particle and for a
+ *         boundary particle no water touches
+ *   R+s   its deposit per face Gamma_R = R / face of substance s [kg/m^2] (0 but for coatings) */
+#ifdef THAW_SURFACE
+#define SUB_F (SUB_G + THAW_NSUB)
+#else
+#define SUB_F (SUB_W + THAW_NSUB)
+#endif
+#define SUB_R (SUB_F + 1)
+#endif
+
 float2 two_sum(float a, float b) {
   const float s = a + b;
   const float bp = s - a;
@@ -177,7 +191,8 @@ kernel void substance_state(global const float4* pos, global const float* densit
                             global const float4* law, global float* sub, global float* shift,
                             global float2* q0, global float2* q1, global float2* q2, global float2* q3,
                             global const float* area, global const float4* normal, global float2* s0,
-                            global float2* s1, global float2* s2, global float2* s3, const SubstanceParams P) {
+                            global float2* s1, global float2* s2, global float2* s3, global float2* d0,
+                            global float2* d1, global float2* d2, global float2* d3, const SubstanceParams P) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uint stride = P.stride;
@@ -199,6 +214,19 @@ kernel void substance_state(global const float4* pos, global const float* densit
     if (held_on.x == 0.0f && held_on.y == 0.0f) continue;
     q[s][i] = add_to_pair(add_to_pair(q[s][i], held_on.x), held_on.y);
     sa[s][i] = (float2)(0.0f);
+  }
+#endif
+#ifdef THAW_DEPOSIT
+  /* A deposit on ice that has melted goes into the particle's own water (sec. 6.4's deposit stays on the
+   * rigid surface it stuck to; that surface is gone). */
+  global float2* dep[4] = {d0, d1, d2, d3};
+  const int boundary = THAW_IS_STATIC(phase[i]);
+  for (int s = 0; s < THAW_NSUB; ++s) {
+    if (!((P.coating >> s) & 1u) || boundary) continue;
+    const float2 stuck = dep[s][i];
+    if (stuck.x == 0.0f && stuck.y == 0.0f) continue;
+    q[s][i] = add_to_pair(add_to_pair(q[s][i], stuck.x), stuck.y);
+    dep[s][i] = (float2)(0.0f);
   }
 #endif
   global const float2* qc[4] = {q0, q1, q2, q3};
@@ -255,6 +283,12 @@ kernel void substance_state(global const float4* pos, global const float* densit
     sub[(SUB_G + s) * stride + i] = surface && ((P.surface >> s) & 1u) ? (a.x + a.y) / own_area : 0.0f;
   }
 #endif
+#ifdef THAW_DEPOSIT
+  for (int s = 0; s < THAW_NSUB; ++s) {
+    const float2 a = dep[s][i];
+    sub[(SUB_R + s) * stride + i] = boundary && ((P.coating >> s) & 1u) ? (a.x + a.y) / P.face : 0.0f;
+  }
+#endif
 }
 
 #ifdef THAW_SURFACE
@@ -294,6 +328,35 @@ kernel void substance_norm(global const float4* pos, global const float* soa, gl
   sub[SUB_NRM * stride + i] = total > 0.0f ? 1.0f / total : 0.0f;
   /* In 2-D the integral of -x . grad W2 over the plane is 2; x . grad W2 = sigma2 / H^4 grad_shape(q) r^2. */
   sub[SUB_MOM * stride + i] = -0.5f * P.sigma2 * (inv_H * inv_H) * (inv_H * inv_H) * lanes_sum(sm);
+}
+#endif
+
+#ifdef THAW_DEPOSIT
+/* Each solid or ice particle's F = face / max(sum_j M_j w(r_ij / H), wet_weight) over the other carriers j
+ * within its support: its uptake from each carrier is weighted by M_j w(r_ij / H) F, so the shares sum to
+ * its face where water fills the wet share of its kernel volume (substance_stage.h's kWetFraction) and to
+ * less where less water touches it; no water, no uptake. */
+kernel void substance_wet(global const float4* pos, global const uchar* phase, global const float* soa,
+                          global float* sub, global const uint* cell_start, const Grid g, const SubstanceParams P) {
+  const uint i = get_global_id(0);
+  if (i >= P.n) return;
+  const uint stride = P.stride;
+  if (!THAW_IS_STATIC(phase[i])) {
+    sub[SUB_F * stride + i] = 0.0f;
+    return;
+  }
+  WALK_START
+  floatV sw = (floatV)(0.0f);
+  FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
+    for (uint j = jb; j < je; j += THAW_VW) {
+      PAIR_LANES(pi, j, period)
+      const floatV mj = vloadV(0, M + j);
+      const intV carrier = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2) & (r2 > 0.0f) & (mj > 0.0f);
+      sw += select((floatV)(0.0f), mj * w_shape(sqrt(r2) * inv_H), carrier);
+    }
+  }
+  const float total = lanes_sum(sw);
+  sub[SUB_F * stride + i] = total > 0.0f ? P.face / fmax(total, P.wet_weight) : 0.0f;
 }
 #endif
 
@@ -375,6 +438,19 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
 #define ADSORBED(a, nrm, g, wgt, wb, s) \
   ((a) * ((nrm) * (wgt)) * ((adsorb[s] * (wb)) * fmax(1.0f - (g) * inv_capacity[s], 0.0f) - desorb[s] * (g)))
 
+/* The amount a boundary particle (F = face / its wet weight, deposit per face G) takes from a carrier of weight
+ * wgt = M w(r / H), mass fractions wc of coating s and wd of its cleanser, over one step: Orthmann et al. 2013
+ * sec. 6.4's coating, Gamma^r = -sigma_r S_i (V_i + V_k) W_ik / 2, as a deposition velocity k_c onto the
+ * boundary's face up to its capacity, less sec. 6.3's cleansing, sigma_r S_i R_k (V_i + V_k) W_ik / 2, as
+ * k_r c_D Gamma_R back into the water,
+ *   R_{k<-j} = face (M_j w_kj / sum_i M_i w_ki) [k_c c_j (1 - Gamma_R,k / Gamma_R,max) - k_r c_D,j Gamma_R,k] dt,
+ * c = rho0 w; a boundary wholly wet takes face (k_c c - k_r c_D Gamma_R) dt from well-mixed water. The
+ * paper's S_i is the coating's and the detergent's amount on the free surface; here the water touching the
+ * boundary carries both in its bulk, as water that wets a plate does. Both sides evaluate this one
+ * expression from the same operands, so the two amounts are equal to the bit. */
+#define DEPOSITED(f, wgt, wc, wd, g, s)                                                            \
+  ((f) * (wgt) * ((coat[s] * (wc)) * fmax(1.0f - (g) * inv_coat_capacity[s], 0.0f) - (cleanse[s] * (wd)) * (g)))
+
 /* One step: each water particle's amounts change by its pairs' diffusive transfers, plus (THAW_REJECT) what
  * the giving ice around it hands it; giving ice loses what it hands out. With THAW_SURFACE, surface-active
  * substances also move between the surface and the bulk (eq. 10, ADSORBED) and along the surface between
@@ -385,12 +461,19 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
 kernel void substance_diffuse(global const float4* pos, global const float* soa, global const float* sub,
                               global const uint* cell_start, const Grid g, const SubstanceParams P,
                               global float2* q0, global float2* q1, global float2* q2, global float2* q3,
-                              global float2* s0, global float2* s1, global float2* s2, global float2* s3) {
+                              global float2* s0, global float2* s1, global float2* s2, global float2* s3,
+                              global float2* d0, global float2* d1, global float2* d2, global float2* d3) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uint stride = P.stride;
   const float mi = sub[SUB_M * stride + i];
+#ifdef THAW_DEPOSIT
+  /* A boundary particle that water touches takes part for its deposits. */
+  const float f_i = sub[SUB_F * stride + i];
+  if (mi == 0.0f && !(f_i > 0.0f)) return;
+#else
   if (mi == 0.0f) return;
+#endif
   WALK_START
   global const float* A = sub + SUB_A * stride;
   const int giving = mi < 0.0f;
@@ -423,13 +506,60 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
     slo[s] = (floatV)(0.0f);
   }
 #endif
+#ifdef THAW_DEPOSIT
+  global const float* F = sub + SUB_F * stride;
+  const float coat[4] = {P.coat0, P.coat1, P.coat2, P.coat3};
+  const float cleanse[4] = {P.cleanse0, P.cleanse1, P.cleanse2, P.cleanse3};
+  const float inv_coat_capacity[4] = {P.inv_coat_capacity0, P.inv_coat_capacity1, P.inv_coat_capacity2,
+                                      P.inv_coat_capacity3};
+  float ri[THAW_NSUB];
+  floatV dhi[THAW_NSUB], dlo[THAW_NSUB];
+  for (int s = 0; s < THAW_NSUB; ++s) {
+    ri[s] = sub[(SUB_R + s) * stride + i];
+    dhi[s] = (floatV)(0.0f);
+    dlo[s] = (floatV)(0.0f);
+  }
+#endif
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
       PAIR_LANES(pi, j, period)
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
       const floatV mj = vloadV(0, M + j);
       const floatV qr = sqrt(r2) * inv_H;
-      if (!giving) {
+#ifdef THAW_DEPOSIT
+      /* i a carrier gives to the wet boundary particles around it (not itself: partly melted ice is both) ... */
+      if (mi > 0.0f) {
+        const floatV f_j = vloadV(0, F + j);
+        const intV wet_j = in & (f_j > 0.0f) & (r2 > 0.0f);
+        if (any(wet_j)) {
+          const floatV wgt = select((floatV)(0.0f), mi * w_shape(qr), wet_j);
+          for (int s = 0; s < THAW_NSUB; ++s) {
+            if (!((P.coating >> s) & 1u)) continue;
+            const uint by = (P.cleanser >> (4 * s)) & 15u;
+            const float wd = by < THAW_NSUB ? wi[by] : 0.0f;
+            const floatV g_j = vloadV(0, sub + (SUB_R + s) * stride + j);
+            const floatV given = -DEPOSITED(f_j, wgt, wi[s], wd, g_j, s);
+            ACCUMULATE(hi[s], lo[s], given)
+          }
+        }
+      }
+      /* ... and i a wet boundary particle takes from the carriers around it. */
+      if (f_i > 0.0f) {
+        const intV carrier = in & (mj > 0.0f) & (r2 > 0.0f);
+        if (any(carrier)) {
+          const floatV wgt = select((floatV)(0.0f), mj * w_shape(qr), carrier);
+          for (int s = 0; s < THAW_NSUB; ++s) {
+            if (!((P.coating >> s) & 1u)) continue;
+            const uint by = (P.cleanser >> (4 * s)) & 15u;
+            const floatV wc = vloadV(0, sub + (SUB_W + s) * stride + j);
+            const floatV wd = by < THAW_NSUB ? vloadV(0, sub + (SUB_W + by) * stride + j) : (floatV)(0.0f);
+            const floatV taken = DEPOSITED(f_i, wgt, wc, wd, ri[s], s);
+            ACCUMULATE(dhi[s], dlo[s], taken)
+          }
+        }
+      }
+#endif
+      if (mi > 0.0f) {
         /* Symmetric in i and j operand by operand (the header); 0 for lanes out of range or not water. */
         const floatV pair = select((floatV)(0.0f), (ai * vloadV(0, A + j)) * (grad_shape(qr) * r2 / (r2 + eta2)),
                                    in & (mj > 0.0f));
@@ -477,8 +607,8 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
       }
 #ifdef THAW_REJECT
       /* Ice gives to water: the giver's amount per weight times the pair's weight, computed alike on both
-       * sides. */
-      const intV handed = in & (giving ? (mj > 0.0f) : (mj < 0.0f));
+       * sides (a boundary particle that only holds deposits, M 0, neither gives nor takes). */
+      const intV handed = in & (giving ? (mj > 0.0f) : (mj < 0.0f)) & (intV)(mi != 0.0f ? -1 : 0);
       /* Givers are rare (water froze through last step): most water skips this for every candidate. */
       if (any(handed)) {
         const floatV w = select((floatV)(0.0f), w_shape(qr), handed);
@@ -491,10 +621,20 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
     }
   }
   global float2* q[4] = {q0, q1, q2, q3};
-  for (int s = 0; s < THAW_NSUB; ++s) {
-    const float2 d = lanes_compensated(hi[s], lo[s]);
-    q[s][i] = add_to_pair(add_to_pair(q[s][i], d.x), d.y);
-  }
+  if (mi != 0.0f)
+    for (int s = 0; s < THAW_NSUB; ++s) {
+      const float2 d = lanes_compensated(hi[s], lo[s]);
+      q[s][i] = add_to_pair(add_to_pair(q[s][i], d.x), d.y);
+    }
+#ifdef THAW_DEPOSIT
+  global float2* dep[4] = {d0, d1, d2, d3};
+  if (f_i > 0.0f)
+    for (int s = 0; s < THAW_NSUB; ++s) {
+      if (!((P.coating >> s) & 1u)) continue;
+      const float2 d = lanes_compensated(dhi[s], dlo[s]);
+      dep[s][i] = add_to_pair(add_to_pair(dep[s][i], d.x), d.y);
+    }
+#endif
 #ifdef THAW_SURFACE
   global float2* sa[4] = {s0, s1, s2, s3};
   if (area_i > 0.0f)

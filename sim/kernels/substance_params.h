@@ -34,10 +34,19 @@ typedef struct {
   float glide0, glide1, glide2, glide3;
   float surface_depth; /* a surface particle's point on the surface lies this far along its normal [m] */
   float sigma2;        /* the kernel's 2-D normalisation times H^2: W2 = sigma2 / H^2 w_shape(r / H) */
+  /* Coatings (THAW_DEPOSIT; Orthmann et al. 2013 sec. 6.3-6.4): */
+  unsigned int coating;  /* bit s: substance s is a coating */
+  unsigned int cleanser; /* 4 bits per substance s: the index of the substance that cleanses it; 15: none */
+  float face;            /* a boundary particle's face, the spacing squared [m^2] */
+  float wet_weight; /* the water weight sum_j M_j w(r / H) past which a boundary particle is wholly wet */
+  /* Each one's rates for a step of dt: k_c rho0 dt [kg/m^2 per unit mass fraction] and k_r rho0 dt [1] */
+  float coat0, coat1, coat2, coat3;
+  float cleanse0, cleanse1, cleanse2, cleanse3;
+  float inv_coat_capacity0, inv_coat_capacity1, inv_coat_capacity2, inv_coat_capacity3; /* 0: no limit */
 } SubstanceParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(SubstanceParams) == 152, "SubstanceParams must match its OpenCL layout");
+static_assert(sizeof(SubstanceParams) == 216, "SubstanceParams must match its OpenCL layout");
 }  // namespace thaw::substance
 #endif
 

@@ -129,6 +129,9 @@ TEST_F(KernelBuild, EveryProgramIsPortableOpenClC) {
   // A surface-active substance beside a salt that lowers the melting point (substance.cl's THAW_SURFACE with
   // THAW_MELT_SHIFT and THAW_REJECT).
   variants.push_back({"salt-on-ice", {"substances.dye={\"kind\": \"surface_active\"}"}});
+  // A coating there (THAW_DEPOSIT with THAW_MELT_SHIFT and THAW_REJECT); wash-the-plate has one beside a
+  // surface-active detergent.
+  variants.push_back({"salt-on-ice", {"substances.dye={\"kind\": \"coating\"}"}});
   // Tension, both models, beside free ice (rigid.cl takes the adhesion's reaction).
   variants.push_back({"default", {"tension.model=akinci2013"}});
   variants.push_back({"default", {"tension.model=iwasaki2010", "solver.pressure=dfsph"}});
