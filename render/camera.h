@@ -6,15 +6,15 @@
 namespace thaw {
 
 struct OrbitCamera {
-  double azimuth = 30.0;                 // [deg]
-  double elevation = 25.0;               // [deg], in (-90, 90)
-  double distance = 0.5;                 // [m]
+  double azimuth = 30.0;    // [deg]
+  double elevation = 25.0;  // [deg], in (-90, 90)
+  double distance = 0.5;    // [m]
   Eigen::Vector3d target = Eigen::Vector3d::Zero();
-  double fov = 40.0;                     // vertical field of view [deg]
-  int width = 640, height = 480;         // [pixels]
+  double fov = 40.0;              // vertical field of view [deg]
+  int width = 640, height = 480;  // [pixels]
 
   Eigen::Vector3d eye() const;
-  Eigen::Matrix4f view() const;          // world -> camera (OpenGL convention: camera looks down -z)
+  Eigen::Matrix4f view() const;  // world -> camera (OpenGL convention: camera looks down -z)
   Eigen::Matrix4f projection(float near, float far) const;
   // The ray through the centre of pixel (x, y), y counted down from the top row: origin at the eye,
   // unit direction.

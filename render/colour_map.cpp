@@ -153,4 +153,13 @@ void label_colour_bar(Image& image, const ColourBar& bar, double lo, double hi, 
   }
 }
 
+Rgb stained(const Rgb& base, double t) {
+  const double f = 0.85 * std::clamp(t, 0.0, 1.0);
+  const Rgb amber = {115, 70, 12};
+  Rgb out{};
+  for (std::size_t k = 0; k < 3; ++k)
+    out[k] = static_cast<std::uint8_t>(std::lround(base[k] + f * (double(amber[k]) - base[k])));
+  return out;
+}
+
 }  // namespace thaw

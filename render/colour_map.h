@@ -15,6 +15,8 @@ Rgb phase_rgb(std::uint8_t phase);
 // A blue-white-red diverging scale (Moreland 2009's cool-warm, sampled at 9 points and interpolated):
 // t = 0 blue, 0.5 near white, 1 red; clamped outside [0, 1].
 Rgb cool_warm(double t);
+// `base` stained by a deposit, t in [0, 1] from none to the most (clamped): toward a dark amber.
+Rgb stained(const Rgb& base, double t);
 
 // The colour bar: a vertical strip at the right edge of the image, `lo` (bottom) to `hi` (top) mapped as
 // the view maps temperatures, with a one-pixel dark frame.

@@ -171,8 +171,9 @@ GLuint compile(GLenum type, const std::string& file, const std::string& defines)
   std::string source(it->second);
   if (!defines.empty()) {
     const std::size_t eol = source.find('\n');
-    source = eol == std::string::npos ? source + "\n" + defines
-                                      : source.substr(0, eol + 1) + defines + "#line 2\n" + source.substr(eol + 1);
+    source = eol == std::string::npos
+                 ? source + "\n" + defines
+                 : source.substr(0, eol + 1) + defines + "#line 2\n" + source.substr(eol + 1);
   }
   const GLuint shader = glCreateShader(type);
   const GLchar* text = source.data();
@@ -305,7 +306,8 @@ bool EglContext::has_gl_extension(const std::string& name) const {
   return has_word(gl_extensions_.c_str(), name);
 }
 
-GLuint build_program(const std::string& vertex_file, const std::string& fragment_file, const std::string& defines) {
+GLuint build_program(const std::string& vertex_file, const std::string& fragment_file,
+                     const std::string& defines) {
   const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file, "");
   GLuint fs = 0;
   try {

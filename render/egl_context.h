@@ -1,8 +1,8 @@
 #pragma once
-// The renderer's OpenGL ES context, with no window and no display server (docs/ARCHITECTURE.md, Renderer): an EGL
-// display from a GPU through EGL_EXT_platform_device (NVIDIA), else Mesa's surfaceless platform
-// (llvmpipe here), and a context current on the thread that created it. The server's render thread
-// owns one; GL calls from any other thread are errors.
+// The renderer's OpenGL ES context, with no window and no display server (docs/ARCHITECTURE.md, Renderer): an
+// EGL display from a GPU through EGL_EXT_platform_device (NVIDIA), else Mesa's surfaceless platform (llvmpipe
+// here), and a context current on the thread that created it. The server's render thread owns one; GL calls
+// from any other thread are errors.
 //
 // Needs OpenGL ES 3.0 (3D textures, R32F textures, GLSL ES 3.00 loops); asks for 3.2, then 3.1, then
 // 3.0. Float textures are filtered linearly only with OES_texture_float_linear (see float_linear()).

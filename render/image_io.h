@@ -1,6 +1,6 @@
 #pragma once
-// Encoding frames once for every consumer (docs/ARCHITECTURE.md, Renderer): JPEG for streams, PNG for files and
-// golden images. All in memory; a failure is a thaw::Error naming the codec and its message.
+// Encoding frames once for every consumer (docs/ARCHITECTURE.md, Renderer): JPEG for streams, PNG for files
+// and golden images. All in memory; a failure is a thaw::Error naming the codec and its message.
 #include <string>
 #include <string_view>
 

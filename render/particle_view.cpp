@@ -132,6 +132,16 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, cons
   const Scalar field =
       by_t ? scalar_of(s, o.colour_by, out.t_min, out.t_max) : Scalar{nullptr, BarUnit::Celsius};
 
+  // Coloured by a coating, the solids and ice it sticks to show it as a stain, the deeper the more they hold
+  // (up to the most any holds), over their phase's colour.
+  const std::vector<float>* stain = nullptr;
+  double stain_max = 0;
+  if (o.colour_by.rfind(kSubstanceColouring, 0) == 0)
+    for (const auto& [sub, values] : s.deposits)
+      if (sub == o.colour_by.substr(std::strlen(kSubstanceColouring)) && values.size() == s.position.size()) {
+        stain = &values;
+        for (float v : values) stain_max = std::max(stain_max, double(v));
+      }
   const Eigen::Matrix4f view = cam.view();
   const double focal = 0.5 * cam.height / std::tan(0.5 * cam.fov * M_PI / 180.0);
   const double radius = 0.5 * s.spacing;
@@ -148,9 +158,13 @@ ViewImage render_particles(const RenderSnapshot& s, const OrbitCamera& cam, cons
     const double px = 0.5 * cam.width + focal * c.x() / z - 0.5,
                  py = 0.5 * cam.height - focal * c.y() / z - 0.5;
     const double r = std::max(0.75, focal * radius / z);
+    const bool boundary =
+        static_cast<Phase>(s.phase[i]) == Phase::Solid || static_cast<Phase>(s.phase[i]) == Phase::Ice;
     Rgb colour = by_t && !(static_cast<Phase>(s.phase[i]) == Phase::Solid)
                      ? cool_warm(((*field.values)[i] - out.t_min) / (out.t_max - out.t_min))
                      : phase_rgb(s.phase[i]);
+    if (stain && boundary)
+      colour = stained(phase_rgb(s.phase[i]), stain_max > 0 ? (*stain)[i] / stain_max : 0.0);
     const int x0 = std::max(0, int(std::floor(px - r))), x1 = std::min(cam.width - 1, int(std::ceil(px + r)));
     const int y0 = std::max(0, int(std::floor(py - r))),
               y1 = std::min(cam.height - 1, int(std::ceil(py + r)));

@@ -52,6 +52,16 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
       }
     }
     s.substances.push_back({sub.name, std::move(c)});
+    if (!sub.coating()) continue;
+    std::vector<float> d(p.size(), 0.0f);
+    const HostColumn* col = p.column(deposited_field(sub.name).name);
+    const double face = scene.spacing * scene.spacing;
+    if (col && col->size() == p.size())
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const Float2& q = col->as<Float2>()[i];
+        d[i] = static_cast<float>((double(q[0]) + double(q[1])) / face);
+      }
+    s.deposits.push_back({sub.name, std::move(d)});
   }
   for (const Dryer& d : scene.dryers)
     s.dryers.push_back({d.position.cast<float>(), d.direction.normalized().cast<float>(),

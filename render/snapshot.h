@@ -38,6 +38,9 @@ struct RenderSnapshot {
   // Each substance the scene declares, by name: its concentration in each particle [kg/m^3 = g/L], bulk and
   // surface amounts over the particle's volume at its material's rest density (0 where it holds none).
   std::vector<std::pair<std::string, std::vector<float>>> substances;
+  // Each coating the scene declares, by name: what sticks to each solid or ice particle per area of its face
+  // [kg/m^2] (0 elsewhere).
+  std::vector<std::pair<std::string, std::vector<float>>> deposits;
   // The scene's dryers as they are at this step, then its taps (emitters): a tap is drawn as a dryer's
   // nozzle that never blows (on = false), its radius the nozzle's.
   std::vector<DryerMarker> dryers;

@@ -300,8 +300,8 @@ void SurfaceRenderer::resize_marched(int width, int height) {
 
 void SurfaceRenderer::set_scale(double scale) {
   if (!(scale >= kMinScale && scale <= 1.0))
-    throw Error("surface renderer: scale " + std::to_string(scale) + " is outside " + std::to_string(kMinScale) +
-                "..1");
+    throw Error("surface renderer: scale " + std::to_string(scale) + " is outside " +
+                std::to_string(kMinScale) + "..1");
   scale_ = scale;
 }
 

@@ -243,18 +243,26 @@ int cmd_run(int argc, char** argv) {
       }
     }
     if (!m.substances.is_null())
-      for (const auto& [name, v] : m.substances.items())
+      for (const auto& [name, v] : m.substances.items()) {
+        // Where it is, where it can be anywhere but in the water.
+        char where[160] = "";
+        if (v["on_surface"].get<double>() != 0 || v["on_solids"].get<double>() != 0)
+          std::snprintf(
+              where, sizeof where, "; dissolved %.4g kg, on the surface %.4g kg, on solids and ice %.4g kg",
+              v["dissolved"].get<double>(), v["on_surface"].get<double>(), v["on_solids"].get<double>());
         std::printf(
-            "substance %s: %.9g kg (outflow %.4g kg, inflow %.4g kg), closure %.3g kg (%.3g relative)\n",
+            "substance %s: %.9g kg (outflow %.4g kg, inflow %.4g kg), closure %.3g kg (%.3g relative)%s\n",
             name.c_str(), v["total"].get<double>(), v["outflow"].get<double>(), v["inflow"].get<double>(),
-            v["closure"].get<double>(), v["closure_relative"].get<double>());
+            v["closure"].get<double>(), v["closure_relative"].get<double>(), where);
+      }
     if (!m.pressure_solve.is_null()) {
       const Json& d = m.pressure_solve;
-      std::printf("dfsph: %.2f density and %.2f divergence iterations per step (mean); last step's errors %.3g "
-                  "(tolerance %.3g) and %.3g (tolerance %.3g)\n",
-                  d["mean_density_iterations"].get<double>(), d["mean_divergence_iterations"].get<double>(),
-                  d["density"]["error"].get<double>(), d["density"]["tolerance"].get<double>(),
-                  d["divergence"]["error"].get<double>(), d["divergence"]["tolerance"].get<double>());
+      std::printf(
+          "dfsph: %.2f density and %.2f divergence iterations per step (mean); last step's errors %.3g "
+          "(tolerance %.3g) and %.3g (tolerance %.3g)\n",
+          d["mean_density_iterations"].get<double>(), d["mean_divergence_iterations"].get<double>(),
+          d["density"]["error"].get<double>(), d["density"]["tolerance"].get<double>(),
+          d["divergence"]["error"].get<double>(), d["divergence"]["tolerance"].get<double>());
     }
     if (!m.bodies.is_null()) {
       int free = 0, fixed = 0;
@@ -267,14 +275,15 @@ int cmd_run(int argc, char** argv) {
   if (const DfsphStage* d = solver.dfsph()) {
     const PressureSolveTotals& t = d->totals();
     if (t.density_unconverged || t.divergence_unconverged)
-      std::fprintf(stderr,
-                   "thaw run: warning: the DFSPH density solve stopped at solver.max_pressure_iterations = %d "
-                   "before its tolerance in %llu of %llu steps (worst mean density error %.3g against %.3g), "
-                   "the divergence solve in %llu; raise max_pressure_iterations or the tolerances, or lower "
-                   "solver.max_dt\n",
-                   solver.scene().solver.max_pressure_iterations, (unsigned long long)t.density_unconverged,
-                   (unsigned long long)t.steps, t.worst_density_error, solver.scene().solver.density_tolerance,
-                   (unsigned long long)t.divergence_unconverged);
+      std::fprintf(
+          stderr,
+          "thaw run: warning: the DFSPH density solve stopped at solver.max_pressure_iterations = %d "
+          "before its tolerance in %llu of %llu steps (worst mean density error %.3g against %.3g), "
+          "the divergence solve in %llu; raise max_pressure_iterations or the tolerances, or lower "
+          "solver.max_dt\n",
+          solver.scene().solver.max_pressure_iterations, (unsigned long long)t.density_unconverged,
+          (unsigned long long)t.steps, t.worst_density_error, solver.scene().solver.density_tolerance,
+          (unsigned long long)t.divergence_unconverged);
   }
   return g_stop ? 130 : 0;
 }

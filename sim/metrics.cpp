@@ -98,15 +98,22 @@ Metrics measure(const Solver& s) {
 Json substances_json(const Solver& s) {
   const std::vector<Substance>& list = s.scene().substances;
   if (list.empty()) return nullptr;
-  const std::vector<double> total = s.substance_totals();
+  const std::vector<SubstanceStage::Parts> parts = s.substance_parts();
   const SubstanceBooks& books = s.substance_books();
   Json out = Json::object();
   for (std::size_t k = 0; k < list.size(); ++k) {
-    const double closure = books.closure(k, total[k]), scale = books.initial[k] + books.inflow[k];
-    out[list[k].name] = {
-        {"total", total[k]},           {"initial", books.initial[k]},
-        {"outflow", books.outflow[k]}, {"inflow", books.inflow[k]},
-        {"closure", closure},          {"closure_relative", scale > 0 ? closure / scale : 0.0}};
+    const SubstanceStage::Parts& p = parts[k];
+    const double total = p.dissolved + p.on_surface + p.on_solids;
+    const double closure = books.closure(k, total), scale = books.initial[k] + books.inflow[k];
+    out[list[k].name] = {{"total", total},
+                         {"dissolved", p.dissolved},
+                         {"on_surface", p.on_surface},
+                         {"on_solids", p.on_solids},
+                         {"initial", books.initial[k]},
+                         {"outflow", books.outflow[k]},
+                         {"inflow", books.inflow[k]},
+                         {"closure", closure},
+                         {"closure_relative", scale > 0 ? closure / scale : 0.0}};
   }
   return out;
 }
@@ -117,7 +124,10 @@ Json pressure_solve_json(const Solver& s) {
   const PressureSolveTotals& t = d->totals();
   const double steps = double(std::max<std::uint64_t>(t.steps, 1));
   auto solve = [](const PressureSolve& p, double tolerance) {
-    return Json{{"iterations", p.iterations}, {"error", p.error}, {"tolerance", tolerance}, {"converged", p.converged}};
+    return Json{{"iterations", p.iterations},
+                {"error", p.error},
+                {"tolerance", tolerance},
+                {"converged", p.converged}};
   };
   const SolverSettings& st = s.scene().solver;
   Json out = {{"density", solve(d->last_density(), st.density_tolerance)},

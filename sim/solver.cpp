@@ -1037,6 +1037,10 @@ std::vector<double> Solver::substance_totals() const {
   return substances_ ? substances_->totals() : std::vector<double>{};
 }
 
+std::vector<SubstanceStage::Parts> Solver::substance_parts() const {
+  return substances_ ? substances_->parts() : std::vector<SubstanceStage::Parts>{};
+}
+
 std::vector<float> Solver::melt_shifts() const {
   return substances_ ? substances_->melt_shifts() : std::vector<float>{};
 }

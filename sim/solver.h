@@ -140,6 +140,8 @@ class Solver {
   // Substances (empty in scenes without them): each one's total over all particles now [kg], summed in
   // double, and its account.
   std::vector<double> substance_totals() const;
+  // Where each substance is (dissolved, on the surface, on solids and ice) [kg]; empty without substances.
+  std::vector<SubstanceStage::Parts> substance_parts() const;
   const SubstanceBooks& substance_books() const { return substance_books_; }
   // Puts `amount` kg of substance s into the water and ice around `at` [m] (substance.drop): shared by the
   // kernel's weight among those within its support, else given to the nearest within three supports, and

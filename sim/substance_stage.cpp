@@ -368,15 +368,27 @@ std::vector<float> SubstanceStage::melt_shifts() const {
 }
 
 std::vector<double> SubstanceStage::totals() const {
-  std::vector<double> out(fields_.size(), 0.0);
+  std::vector<double> out;
+  for (const Parts& p : parts()) out.push_back(p.dissolved + p.on_surface + p.on_solids);
+  return out;
+}
+
+std::vector<SubstanceStage::Parts> SubstanceStage::parts() const {
+  std::vector<Parts> out(fields_.size());
   const std::size_t n = layout_.n;
   if (n == 0) return out;
   std::vector<Float2> a(n);
-  for (std::size_t s = 0; s < fields_.size(); ++s)
-    for (const ParticleStore::Field f : amount_fields(s)) {
-      cl_.queue().enqueueReadBuffer(store_[f], CL_TRUE, 0, n * sizeof(Float2), a.data());
-      for (const Float2& v : a) out[s] += double(v[0]) + double(v[1]);
-    }
+  auto sum = [&](ParticleStore::Field f) {
+    cl_.queue().enqueueReadBuffer(store_[f], CL_TRUE, 0, n * sizeof(Float2), a.data());
+    double total = 0;
+    for (const Float2& v : a) total += double(v[0]) + double(v[1]);
+    return total;
+  };
+  for (std::size_t s = 0; s < fields_.size(); ++s) {
+    out[s].dissolved = sum(fields_[s]);
+    if (adsorbed_[s] >= 0) out[s].on_surface = sum(adsorbed_fields_[std::size_t(adsorbed_[s])]);
+    if (deposited_[s] >= 0) out[s].on_solids = sum(deposited_fields_[std::size_t(deposited_[s])]);
+  }
   return out;
 }
 

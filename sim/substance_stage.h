@@ -109,6 +109,11 @@ class SubstanceStage {
 
   // Each substance's total over all particles [kg], summed in double from the device's pairs.
   std::vector<double> totals() const;
+  // Where each substance is [kg]: dissolved in the water, on its free surface, stuck to solids and ice.
+  struct Parts {
+    double dissolved = 0, on_surface = 0, on_solids = 0;
+  };
+  std::vector<Parts> parts() const;
 
  private:
   ClRuntime& cl_;

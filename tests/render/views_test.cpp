@@ -161,6 +161,36 @@ TEST(ParticleView, SubstanceColoursRunFromNoneToTheMost) {
   EXPECT_THROW(check_colouring("salt", "colour_by"), Error);
 }
 
+// Coloured by a coating, ice and solids show what sticks to them as a stain over their phase's colour, the
+// most any holds at the stain's full depth; by anything else, no stain.
+TEST(ParticleView, ACoatingStainsTheSolidsAndIceItSticksTo) {
+  RenderSnapshot s = two_particles(-5.0f, 20.0f);
+  s.position.push_back({0.0f, 0.0f, 0.05f});
+  s.phase.push_back(static_cast<std::uint8_t>(Phase::Solid));
+  s.temperature.push_back(20.0f);
+  s.substances = {{"grease", {0.0f, 1.0f, 0.0f}}};
+  s.deposits = {{"grease", {2e-5f, 0.0f, 1e-4f}}};  // ice a fifth of the solid's
+  const OrbitCamera cam = front_camera();
+  ParticleViewOptions o;
+  o.colour_by = "substance:grease";
+  const ViewImage v = render_particles(s, cam, o);
+  int x = 0, y = 0;
+  project(cam, s.position[2], x, y);
+  EXPECT_GT(chroma(v.image.pixel(x, y)).dot(chroma(stained(phase_rgb(std::uint8_t(Phase::Solid)), 1.0))),
+            0.999);
+  project(cam, s.position[0], x, y);
+  EXPECT_GT(chroma(v.image.pixel(x, y)).dot(chroma(stained(phase_rgb(std::uint8_t(Phase::Ice)), 0.2))),
+            0.999);
+  project(cam, s.position[1], x, y);  // the water by its concentration
+  EXPECT_GT(chroma(v.image.pixel(x, y)).dot(chroma(cool_warm(1.0))), 0.999);
+  o.colour_by = "phase";
+  const ViewImage plain = render_particles(s, cam, o);
+  project(cam, s.position[2], x, y);
+  EXPECT_GT(chroma(plain.image.pixel(x, y)).dot(chroma(phase_rgb(std::uint8_t(Phase::Solid)))), 0.999);
+  EXPECT_LT(chroma(plain.image.pixel(x, y)).dot(chroma(stained(phase_rgb(std::uint8_t(Phase::Solid)), 1.0))),
+            0.99);
+}
+
 TEST(ParticleView, UnknownColouringAndMissingTemperaturesAreErrors) {
   RenderSnapshot s = two_particles(0.0f, 1.0f);
   ParticleViewOptions o;
