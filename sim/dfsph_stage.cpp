@@ -21,7 +21,7 @@ constexpr int kColumns = 5;
 // hydrostatic tank's kinetic energy grew tenfold every 10 ms until it blew up. Half, as SPlisHSPlasH's
 // implementation does, decays what is no longer needed geometrically.
 constexpr float kWarmShare = 0.5f;
-}
+}  // namespace
 
 double dfsph_rest_ratio(const Scene& scene) {
   const auto w = scene.solver.kernel == KernelFunction::WendlandC2 ? sph::wendland_c2_w : sph::cubic_spline_w;
@@ -135,7 +135,8 @@ double DfsphStage::closed_gas_volume_factor() {
 
 double DfsphStage::mean_error(double rest_density) {
   if (layout_.ntiles == 0) return 0.0;
-  set_args(k_sum_, col_, store_[f_.phase], sums_, layout_.stride, static_cast<cl_uint>(layout_.n), layout_.tile);
+  set_args(k_sum_, col_, store_[f_.phase], sums_, layout_.stride, static_cast<cl_uint>(layout_.n),
+           layout_.tile);
   const auto [sum, count] = tile_sums(k_sum_);
   return count > 0 ? sum / count / rest_density : 0.0;
 }
@@ -168,13 +169,14 @@ PressureSolve DfsphStage::solve(const NeighbourView& nv, double dt, bool density
     launch(q, k_extrapolate_, layout_.n);
   };
   set_args(k_correct_, store_[f_.velocity], nv.soa, store_[f_.phase], col_, store_[f_.position],
-           store_[f_.density], store_[kappa_], nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride, n);
+           store_[f_.density], store_[kappa_], nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride,
+           n);
   if (warm) {
     extrapolate(density_mode);
     launch(q, k_correct_, layout_.n);
   }
-  set_args(k_error_, store_[f_.position], nv.soa, store_[f_.density], store_[f_.phase], store_[f_.material], flow_,
-           col_, nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride, n);
+  set_args(k_error_, store_[f_.position], nv.soa, store_[f_.density], store_[f_.phase], store_[f_.material],
+           flow_, col_, nv.cell_start, nv.grid, support_, fdt, mode, layout_.stride, n);
   // The density error is (rho* - rho0), the divergence error D rho / Dt; both as fractions of rho0, the
   // second over one step.
   const double scale = density_mode ? 1.0 : dt;

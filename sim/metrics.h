@@ -24,7 +24,7 @@ struct Metrics {
   // Air particles (scenes with `air`): their mass and temperatures, apart from the ice and water's.
   double air_mass = 0;                                                                // [kg]
   double air_min_temperature = 0, air_mean_temperature = 0, air_max_temperature = 0;  // [°C]
-  double enthalpy = 0;                                                    // total sum m h [J]
+  double enthalpy = 0;                                                                // total sum m h [J]
   double enthalpy_scale = 0;  // sum m |h| [J]: the size round-off is measured against
   EnergyBudget budget;
   OutflowBooks outflow;  // what left through open sides

@@ -72,7 +72,7 @@ class NeighbourGrid {
   const Scene& scene_;
   const ParticleLayout& layout_;
   GridInfo info_;
-  bool intake_ = false;  // the scene has air dryers: the key pass takes in what their intakes hold
+  bool intake_ = false;            // the scene has air dryers: the key pass takes in what their intakes hold
   std::vector<cl_uint2> flagged_;  // (index, flag) of the particles intake_flags listed
   std::uint32_t ncells_ = 0, sort_passes_ = 0, radix_bits_ = 8;
   cl_uint blowing_ = 0;  // air dryers blowing at the last build()

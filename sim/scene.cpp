@@ -55,6 +55,10 @@ const char* name(KernelFunction k) {
 const char* name(Eos e) { return e == Eos::Tait ? "tait" : "linear"; }
 const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph" : "wcsph"; }
 const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
+const char* name(TensionLaw l) {
+  return l == TensionLaw::Szyszkowski ? "szyszkowski" : l == TensionLaw::Linear ? "linear" : "none";
+}
+
 const char* name(SubstanceKind k) {
   return k == SubstanceKind::SurfaceActive ? "surface_active"
          : k == SubstanceKind::Coating     ? "coating"
@@ -533,6 +537,14 @@ Scene convert_and_check(Json doc, const std::string& folder) {
       sub.adsorption_rate = d["adsorption_rate"].get<double>();
       sub.desorption_rate = d["desorption_rate"].get<double>();
       sub.surface_capacity = d["surface_capacity"].get<double>();
+      sub.tension_law = choice_of<TensionLaw>(
+          d["tension_law"], {TensionLaw::None, TensionLaw::Szyszkowski, TensionLaw::Linear});
+      sub.tension_scale = d["tension_scale"].get<double>();
+      if (sub.lowers_tension() && sub.surface_capacity <= 0 && s.tension.enabled())
+        throw SceneError("substances." + name + ".tension_law",
+                         std::string("the ") + thaw::name(sub.tension_law) +
+                             " law is written in Gamma / Gamma_max: it needs a surface_capacity above 0 (or "
+                             "tension_law none)");
     }
     if (sub.coating()) {
       sub.coating_rate = d["coating_rate"].get<double>();

@@ -39,6 +39,10 @@ enum class DfsphBoundary { Adami2012, Akinci2012 };
 // How fluids of several rest densities meet (dfsph, sim/kernels/dfsph.cl).
 enum class Multiphase { HuAdams2006, DomaradzkiMartyn };
 enum class SubstanceKind { Bulk, SurfaceActive, Coating };
+// How a surface-active substance lowers the water's surface tension (sim/kernels/substance.cl): not at all,
+// by Szyszkowski's law sigma0 + E ln(1 - Gamma / Gamma_max) (Langmuir's isotherm's own equation of state), or
+// by its linear part sigma0 - E Gamma / Gamma_max.
+enum class TensionLaw { None, Szyszkowski, Linear };
 enum class ExposedArea { Iwasaki2010, Orthmann2013, Brackbill1992 };
 // Interfacial tension (sim/tension_stage.h): none, Akinci et al. 2013's cohesion, curvature and adhesion, or
 // Iwasaki et al. 2010's eq. 4.
@@ -56,6 +60,7 @@ const char* name(Eos e);             // "tait", "linear"
 const char* name(PressureSolver p);  // "wcsph", "dfsph"
 const char* name(BoundaryVolume b);  // "lattice", "akinci"
 const char* name(SubstanceKind k);   // "bulk", "surface_active", "coating"
+const char* name(TensionLaw l);      // "none", "szyszkowski", "linear"
 const char* name(ExposedArea a);     // "iwasaki2010", "orthmann2013", "brackbill1992"
 const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
 const char* name(Multiphase m);      // "hu_adams2006", "domaradzki_martyn"
@@ -140,7 +145,10 @@ struct Substance {
   double adsorption_rate = 1e-4;      // k_a [m/s]
   double desorption_rate = 0.1;       // k_d [1/s]
   double surface_capacity = 1.2e-6;   // Gamma_max [kg/m^2]; 0: unlimited (Henry's law)
+  TensionLaw tension_law = TensionLaw::Szyszkowski;
+  double tension_scale = 7.9e-3;  // E = R T Gamma_inf [N/m] (SDS at 25 °C: 3.2e-6 mol/m^2)
   bool surface_active() const { return kind == SubstanceKind::SurfaceActive; }
+  bool lowers_tension() const { return surface_active() && tension_law != TensionLaw::None; }
   // A coating (Orthmann et al. 2013 sec. 6.3-6.4: paint, dye that stains, grease) also sticks to the solids
   // and ice the water touches, an amount per boundary particle over its face (a deposit Gamma_R [kg/m^2]):
   // dGamma_R/dt = k_c c (1 - Gamma_R / Gamma_R,max) - k_r c_D Gamma_R, c its concentration in the water

@@ -467,6 +467,22 @@ const Field& scene_schema() {
                          "coating (paint, a staining dye, grease): it also sticks to the solids and ice "
                          "the water touches, and a cleanser takes it back (sec. 6.3-6.4)")
                       .def("bulk"),
+                  choice(
+                      "tension_law", {"szyszkowski", "linear", "none"},
+                      "How it lowers the water's surface tension where the surface holds it (where "
+                      "tension.model is on): szyszkowski, sigma0 + E ln(1 - Gamma / Gamma_max) (Langmuir's "
+                      "equation of state); linear, sigma0 - E Gamma / Gamma_max; none")
+                      .def("szyszkowski")
+                      .when("kind", "surface_active"),
+                  number(
+                      "tension_scale",
+                      "E in the tension law: R T Gamma_inf, Gamma_inf the surface's capacity in mol/m^2 (SDS "
+                      "at 25 °C: 7.9e-3)")
+                      .in("N/m")
+                      .def(7.9e-3)
+                      .at_least(0)
+                      .at_most(1)
+                      .when("kind", "surface_active"),
                   number("coating_rate",
                          "k_c in dGamma_R/dt = k_c c (1 - Gamma_R / Gamma_R,max) - k_r c_D Gamma_R: the "
                          "speed at which it deposits from the water onto a solid or ice surface")

@@ -389,6 +389,8 @@ void Solver::build(const SimState& st, std::size_t capacity) {
                                          heat_ ? &enthalpy : nullptr, surface_ ? &surface : nullptr);
   }
   if (substances_ && substances_->lowers_melting()) heat_->melt_shift_from(substances_->melt_shift());
+  if (tension_ && substances_ && substances_lower_tension(scene_))
+    tension_->ratio_from(substances_->tension_ratio());
   if (fluid_ && heat_) fluid_->buoyancy_from(heat_->enthalpy());
   if (dfsph_ && heat_) dfsph_->rest_density_from(heat_->enthalpy());
   store_.allocate(layout_.capacity);

@@ -24,6 +24,18 @@ FieldSpec deposited_field(const std::string& name) {
   return {kDepositedPrefix + name, FieldType::Float32, 2, true, false};
 }
 
+bool substances_lower_tension(const Scene& scene) {
+  return scene.solver.flow && scene.tension.enabled() &&
+         std::any_of(scene.substances.begin(), scene.substances.end(),
+                     [](const Substance& s) { return s.lowers_tension(); });
+}
+
+// Saved: the tension pass of a resumed run's first step reads the ratios the straight run's last step left.
+// 1 (0x3f800000) where a state has none.
+FieldSpec tension_ratio_field() {
+  return {kTensionRatioField, FieldType::Float32, 1, true, true, 0x3f800000u};
+}
+
 bool substances_coat(const Scene& scene) {
   return std::any_of(scene.substances.begin(), scene.substances.end(),
                      [](const Substance& s) { return s.coating(); });
@@ -136,6 +148,18 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   if (rejects) opts += " -DTHAW_REJECT";
   if (surface_) opts += " -DTHAW_SURFACE";
   if (deposit_) opts += " -DTHAW_DEPOSIT";
+  lowers_tension_ = surface_ && substances_lower_tension(scene);
+  if (lowers_tension_) {
+    opts += " -DTHAW_TENSION_LAW";
+    ratio_ = store.add(tension_ratio_field());
+    for (std::size_t s = 0; s < scene.substances.size(); ++s) {
+      const Substance& sub = scene.substances[s];
+      if (!sub.lowers_tension()) continue;
+      params_.tension_law |= (sub.tension_law == TensionLaw::Szyszkowski ? 1u : 2u) << (2 * s);
+      float* e[4] = {&params_.tension0, &params_.tension1, &params_.tension2, &params_.tension3};
+      *e[s] = static_cast<float>(sub.tension_scale / scene.tension.coefficient);
+    }
+  }
   ice_pass_ = lowers_ || rejects;
   if (enthalpy) enthalpy_ = *enthalpy;
   for (int a = 0; a < 3; ++a)
@@ -357,7 +381,7 @@ void SubstanceStage::diffuse(double dt, const NeighbourView& nv) {
   }
   set_args(k_diffuse_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_, amount(0),
            amount(1), amount(2), amount(3), on_surface(0), on_surface(1), on_surface(2), on_surface(3),
-           on_solids(0), on_solids(1), on_solids(2), on_solids(3));
+           on_solids(0), on_solids(1), on_solids(2), on_solids(3), lowers_tension_ ? store_[ratio_] : sub_);
   launch(cl_.queue(), k_diffuse_, layout_.n);
 }
 

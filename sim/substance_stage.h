@@ -38,6 +38,13 @@ FieldSpec deposited_field(const std::string& name);
 // volume is water; less wetted, over that share of it. The first boundary layer under a flat, lattice-
 // sampled pool has 0.128 of its volume in water (Wendland C2, support 2 spacings), the second none.
 inline constexpr double kWetFraction = 0.1;
+// Whether the scene's surface-active substances lower its surface tension: some has a tension_law, and the
+// scene has flow and tension. The substance stage then keeps each water particle's tension over the scene's,
+// sigma_i / sigma0, in the field kTensionRatioField (1 off the surface; saved), and the tension stage reads
+// it.
+bool substances_lower_tension(const Scene& scene);
+inline constexpr const char* kTensionRatioField = "tension_ratio";
+FieldSpec tension_ratio_field();
 // Whether some substance of the scene is a coating: then boundary particles hold deposits.
 bool substances_coat(const Scene& scene);
 
@@ -107,6 +114,9 @@ class SubstanceStage {
   // The melt shift of each particle as the last prepare() left it [K]; empty unless lowers_melting().
   std::vector<float> melt_shifts() const;
 
+  // The field of sigma_i / sigma0 (substances_lower_tension), renewed by diffuse(); 0 without one.
+  ParticleStore::Field tension_ratio() const { return ratio_; }
+
   // Each substance's total over all particles [kg], summed in double from the device's pairs.
   std::vector<double> totals() const;
   // Where each substance is [kg]: dissolved in the water, on its free surface, stuck to solids and ice.
@@ -143,6 +153,8 @@ class SubstanceStage {
   std::vector<int> deposited_;
   std::vector<ParticleStore::Field> deposited_fields_;
   cl::Kernel k_wet_;
+  bool lowers_tension_ = false;  // THAW_TENSION_LAW
+  ParticleStore::Field ratio_ = 0;
   const cl::Buffer& on_solids(std::size_t s) const;  // substance s's deposit field, or any past the last
   cl::Buffer sub_, fluid_, law_;
   const cl::Buffer& amount(std::size_t s) const;  // substance s's field, or the first's past the last

@@ -6,6 +6,7 @@
 
 #include "sim/cl_launch.h"
 #include "sim/solver.h"
+#include "sim/substance_stage.h"
 
 namespace thaw {
 
@@ -97,6 +98,8 @@ TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields
             std::to_string(static_cast<int>(std::ceil(tension::kFitRadius * dx / k.support)));
   // Adhesion only where water can meet solids or ice.
   if (!scene.walls.empty() || !scene.solids.empty() || !scene.ice.empty()) opts += " -DTHAW_TENSION_ADHESION";
+  lowered_ = substances_lower_tension(scene);
+  if (lowered_) opts += " -DTHAW_TENSION_LOWERED";
   const auto program =
       cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "tension_params.h", "tension.cl"}, opts);
   k_columns_ = cl::Kernel(program, "tension_columns");
@@ -126,7 +129,8 @@ TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields
   if (adhesion.empty()) adhesion.push_back(0.0f);
   adhesion_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                          adhesion.size() * sizeof(float), adhesion.data());
-  const std::size_t bytes = std::size_t(layout.stride) * (csf ? kCsfColumns : kColumns) * sizeof(float);
+  const std::size_t bytes =
+      std::size_t(layout.stride) * ((csf ? kCsfColumns : kColumns) + (lowered_ ? 1 : 0)) * sizeof(float);
   columns_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, bytes);
   cl.queue().enqueueFillBuffer(columns_, 0.0f, 0, bytes);
 }
@@ -138,7 +142,7 @@ void TensionStage::run(const NeighbourView& nv, const cl::Buffer& accel) {
   P.stride = nv.stride;
   auto& q = cl_.queue();
   set_args(k_columns_, store_[core_.phase], store_[core_.material], store_[core_.position],
-           store_[core_.density], adhesion_, P, columns_);
+           store_[core_.density], adhesion_, P, columns_, lowered_ ? store_[ratio_] : adhesion_);
   launch(q, k_columns_, nv.stride);
   if (model_ == TensionModel::Akinci2013) {
     set_args(k_normals_, store_[core_.position], store_[core_.phase], nv.soa, nv.cell_start, nv.grid, P,

@@ -51,6 +51,11 @@ class TensionStage {
   // Adds the tension accelerations to `accel` (the forces pass's), from the densities of the last density
   // pass.
   void run(const NeighbourView& nv, const cl::Buffer& accel);
+  // Where the scene's surface-active substances lower the tension (substances_lower_tension): the field of
+  // each particle's sigma_i / sigma0 that the substance stage keeps. Each model scales its force by it; the
+  // pair models a pair's cohesion by the mean of its two, brackbill1992 sigma kappa n, plus Marangoni's
+  // stress along the surface.
+  void ratio_from(ParticleStore::Field ratio) { ratio_ = ratio; }
 
  private:
   ClRuntime& cl_;
@@ -62,6 +67,8 @@ class TensionStage {
   cl::Kernel k_columns_, k_normals_, k_forces_;
   cl::Kernel k_surface_, k_curvature_, k_smooth_;  // brackbill1992
   cl::Buffer adhesion_, columns_;
+  bool lowered_ = false;  // THAW_TENSION_LOWERED
+  ParticleStore::Field ratio_ = 0;
 };
 
 }  // namespace thaw

@@ -50,14 +50,14 @@ double max_diffusivity(const Scene& scene);
 // or off). Each source is compiled into the heat pass only when the scene has it. An isothermal scene
 // (a dam break at 20 °C in 20 °C air) builds no heat at all: no enthalpy sort, no heat pass, no read-back.
 struct HeatPlan {
-  bool build = false;    // the heat stage at all
-  bool ambient = false;  // exchange with the ambient air (heat.ambient_coefficient > 0)
-  bool dryers = false;   // the scene has dryers
-  bool walls = false;    // tank walls exchange heat with the outside (heat.wall_coefficient > 0)
-  bool lamps = false;    // the scene has lamps (the photon grid is built once one is on)
+  bool build = false;      // the heat stage at all
+  bool ambient = false;    // exchange with the ambient air (heat.ambient_coefficient > 0)
+  bool dryers = false;     // the scene has dryers
+  bool walls = false;      // tank walls exchange heat with the outside (heat.wall_coefficient > 0)
+  bool lamps = false;      // the scene has lamps (the photon grid is built once one is on)
   bool adiabatic = false;  // the scene has adiabatic solids (their mirrored temperatures: heat.cl)
   bool air_faces = false;  // air relaxes toward the ambient near the sides (air.face_exchange_time > 0)
-  std::string reason;    // why heat is built or not, in words, for `thaw run`'s list of stages
+  std::string reason;      // why heat is built or not, in words, for `thaw run`'s list of stages
 };
 HeatPlan plan_heat(const Scene& scene, const HostParticles& particles);
 

@@ -462,7 +462,8 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
                               global const uint* cell_start, const Grid g, const SubstanceParams P,
                               global float2* q0, global float2* q1, global float2* q2, global float2* q3,
                               global float2* s0, global float2* s1, global float2* s2, global float2* s3,
-                              global float2* d0, global float2* d1, global float2* d2, global float2* d3) {
+                              global float2* d0, global float2* d1, global float2* d2, global float2* d3,
+                              global float* tension_ratio) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uint stride = P.stride;
@@ -643,5 +644,24 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
       const float2 d = lanes_compensated(shi[s], slo[s]);
       sa[s][i] = add_to_pair(add_to_pair(sa[s][i], d.x), d.y);
     }
+#endif
+#ifdef THAW_TENSION_LAW
+  /* Each water particle's surface tension over the scene's, from the surface excess it now holds: each
+   * substance with a law lowers it by Szyszkowski's E ln(1 - Gamma / Gamma_max) (the equation of state of a
+   * Langmuir monolayer; theta is kept below 0.999, where it is already 6.9 E down) or linearly by
+   * E Gamma / Gamma_max, the sum floored at 0. 1 off the surface. The tension pass reads it next step. */
+  if (mi > 0.0f) {
+    const float drop[4] = {P.tension0, P.tension1, P.tension2, P.tension3};
+    float ratio = 1.0f;
+    if (area_i > 0.0f)
+      for (int s = 0; s < THAW_NSUB; ++s) {
+        const uint law = (P.tension_law >> (2 * s)) & 3u;
+        if (law == 0u) continue;
+        const float2 held = sa[s][i];
+        const float theta = clamp((held.x + held.y) / area_i * inv_capacity[s], 0.0f, 0.999f);
+        ratio += law == 1u ? drop[s] * log(1.0f - theta) : -drop[s] * theta;
+      }
+    tension_ratio[i] = fmax(ratio, 0.0f);
+  }
 #endif
 }

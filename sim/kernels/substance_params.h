@@ -43,10 +43,14 @@ typedef struct {
   float coat0, coat1, coat2, coat3;
   float cleanse0, cleanse1, cleanse2, cleanse3;
   float inv_coat_capacity0, inv_coat_capacity1, inv_coat_capacity2, inv_coat_capacity3; /* 0: no limit */
+  /* Surface tension (THAW_TENSION_LAW): 2 bits per substance s, its law (0 none, 1 Szyszkowski, 2 linear),
+   * and each one's E / sigma0 */
+  unsigned int tension_law;
+  float tension0, tension1, tension2, tension3;
 } SubstanceParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(SubstanceParams) == 216, "SubstanceParams must match its OpenCL layout");
+static_assert(sizeof(SubstanceParams) == 236, "SubstanceParams must match its OpenCL layout");
 }  // namespace thaw::substance
 #endif
 

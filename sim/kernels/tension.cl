@@ -28,10 +28,18 @@
 #define COL_K2 9
 #define COL_OK 10
 #define COL_BAND 11
+/* With -DTHAW_TENSION_LOWERED (surface-active substances that lower the tension; the substance stage's
+ * tension_ratio field, substance.cl), after the block above:
+ *   S: each water particle's tension over the scene's, sigma_i / sigma0 (1 off the surface) */
+#ifdef THAW_TENSION_BRACKBILL1992
+#define COL_S 12
+#else
+#define COL_S 7
+#endif
 
 kernel void tension_columns(global const uchar* phase, global const uchar* material, global const float4* pos,
                             global const float* density, global const float* adhesion, const TensionParams P,
-                            global float* col) {
+                            global float* col, global const float* ratio) {
   const uint i = get_global_id(0);
   const uint stride = P.stride;
   if (i >= stride) return;
@@ -64,6 +72,9 @@ kernel void tension_columns(global const uchar* phase, global const uchar* mater
   col[(COL_NX + 2) * stride + i] = 0.0f;
 #ifdef THAW_TENSION_BRACKBILL1992
   for (int k = COL_A; k <= COL_BAND; ++k) col[k * stride + i] = 0.0f;
+#endif
+#ifdef THAW_TENSION_LOWERED
+  col[COL_S * stride + i] = i < P.n ? ratio[i] : 1.0f;
 #endif
 }
 
@@ -341,6 +352,10 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
   global const float* W = col + COL_W * stride;
   global const float* B = col + COL_B * stride;
   const float rho_i = col[COL_R * stride + i];
+#ifdef THAW_TENSION_LOWERED
+  global const float* S = col + COL_S * stride;
+  const float s_i = S[i];
+#endif
   floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
 #ifdef THAW_TENSION_AKINCI2013
   global const float* NX = col + (COL_NX + 0) * stride;
@@ -366,8 +381,15 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
 #if defined(THAW_TENSION_ADHESION) || defined(THAW_TENSION_IWASAKI2010)
       const floatV b = vloadV(0, B + j);
 #endif
+#ifdef THAW_TENSION_LOWERED
+      /* The pair's cohesion by the mean of the two tensions: symmetric, so the pair forces still move no
+       * momentum, and a water particle pulls less where a surfactant lowered its tension. */
+      const floatV pair_s = 0.5f * (s_i + vloadV(0, S + j));
+#else
+      const floatV pair_s = (floatV)(1.0f);
+#endif
 #ifdef THAW_TENSION_IWASAKI2010
-      const floatV s = -(P.cohesion * vloadV(0, W + j) + b) * inv_m / fmax(r2, 1e-30f);
+      const floatV s = -(P.cohesion * vloadV(0, W + j) * pair_s + b) * inv_m / fmax(r2, 1e-30f);
       const floatV fx = s * dx, fy = s * dy, fz = s * dz;
 #else
       /* approximate reciprocals: the shapes need no more, and divisions cost a third of the pass (forces.cl) */
@@ -381,8 +403,8 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
 #else
       const floatV sa = (floatV)(0.0f);
 #endif
-      const floatV s = -cohesion * k * w * akinci_cohesion_shape(q) * inv_r + sa;
-      const floatV kc = select((floatV)(0.0f), -curv * k, w > 0.0f);
+      const floatV s = -cohesion * k * w * pair_s * akinci_cohesion_shape(q) * inv_r + sa;
+      const floatV kc = select((floatV)(0.0f), -curv * k * pair_s, w > 0.0f);
       const floatV fx = s * dx + kc * (nix - nx), fy = s * dy + kc * (niy - ny), fz = s * dz + kc * (niz - nz);
 #endif
       ax += select((floatV)(0.0f), fx, in);
@@ -405,7 +427,57 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
   const float3 n = (float3)(col[(COL_NX + 0) * stride + i], col[(COL_NX + 1) * stride + i],
                             col[(COL_NX + 2) * stride + i]);
   /* 0 off the outer layer and where the fit failed (A and K are 0 there) */
-  float3 a = -P.sigma * col[COL_K * stride + i] * col[COL_A * stride + i] / pi.w * n;
+#ifdef THAW_TENSION_LOWERED
+  const float s_i = col[COL_S * stride + i];
+#else
+  const float s_i = 1.0f;
+#endif
+  const float area_i = col[COL_A * stride + i];
+  float3 a = -(P.sigma * s_i) * col[COL_K * stride + i] * area_i / pi.w * n;
+#ifdef THAW_TENSION_LOWERED
+  /* Marangoni's stress: a surface whose tension varies pulls along itself toward the higher tension, the
+   * surface gradient of sigma on the particle's area (the CSF's tangential part; Brackbill et al. 1992
+   * eq. 30). The gradient is fitted by weighted least squares to sigma_j - sigma_i over the outer layer's
+   * particles in the support, on the tangent plane of n_i, so a linear sigma gives its slope exactly. */
+  if (area_i > 0.0f) {
+    const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+    const int4 c = grid_cell(g, pi);
+    global const float* X = soa;
+    global const float* Y = soa + stride;
+    global const float* Z = soa + 2 * stride;
+    global const float* A = col + COL_A * stride;
+    global const float* S = col + COL_S * stride;
+    const float3 e = fabs(n.x) < 0.6f ? (float3)(1.0f, 0.0f, 0.0f) : (float3)(0.0f, 1.0f, 0.0f);
+    const float3 t1 = normalize(cross(n, e)), t2 = cross(n, t1);
+    floatV s11 = (floatV)(0.0f), s12 = (floatV)(0.0f), s22 = (floatV)(0.0f), b1 = (floatV)(0.0f),
+           b2 = (floatV)(0.0f);
+    FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
+      const float4 pr = THAW_ROW_POS(g, c, pi);
+      for (uint j = jb; j < je; j += THAW_VW) {
+        const floatV dx = vloadV(0, X + j) - pr.x, dy = vloadV(0, Y + j) - pr.y, dz = vloadV(0, Z + j) - pr.z;
+        const floatV r2 = dx * dx + dy * dy + dz * dz;
+        const floatV area_j = vloadV(0, A + j);
+        const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2) & (r2 > 1e-12f * H2) & (area_j > 0.0f);
+        const floatV w = select((floatV)(0.0f), area_j * w_shape(sqrt(r2) * inv_H), in);
+        const floatV d1 = dx * t1.x + dy * t1.y + dz * t1.z, d2 = dx * t2.x + dy * t2.y + dz * t2.z;
+        const floatV ds = select((floatV)(0.0f), vloadV(0, S + j) - s_i, in);
+        s11 += w * d1 * d1;
+        s12 += w * d1 * d2;
+        s22 += w * d2 * d2;
+        b1 += w * ds * d1;
+        b2 += w * ds * d2;
+      }
+    }
+    const float m11 = lanes_sum(s11), m12 = lanes_sum(s12), m22 = lanes_sum(s22);
+    const float det = m11 * m22 - m12 * m12;
+    /* Fewer than two independent directions (a lone surface particle): no gradient. */
+    if (det > 1e-6f * (m11 + m22) * (m11 + m22)) {
+      const float v1 = lanes_sum(b1), v2 = lanes_sum(b2);
+      const float g1 = (m22 * v1 - m12 * v2) / det, g2 = (m11 * v2 - m12 * v1) / det;
+      a += (P.sigma * area_i / pi.w) * (g1 * t1 + g2 * t2);
+    }
+  }
+#endif
 #ifdef THAW_TENSION_ADHESION
   {
     const float H = P.support, H2 = H * H, inv_H = 1.0f / H;

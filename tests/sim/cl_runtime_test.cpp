@@ -132,6 +132,9 @@ TEST_F(KernelBuild, EveryProgramIsPortableOpenClC) {
   // A coating there (THAW_DEPOSIT with THAW_MELT_SHIFT and THAW_REJECT); wash-the-plate has one beside a
   // surface-active detergent.
   variants.push_back({"salt-on-ice", {"substances.dye={\"kind\": \"coating\"}"}});
+  // Tension lowered by wash-the-plate's detergent, each model (THAW_TENSION_LOWERED, THAW_TENSION_LAW).
+  for (const char* model : {"akinci2013", "iwasaki2010", "brackbill1992"})
+    variants.push_back({"wash-the-plate", {std::string("tension.model=") + model}});
   // Tension, both models, beside free ice (rigid.cl takes the adhesion's reaction).
   variants.push_back({"default", {"tension.model=akinci2013"}});
   variants.push_back({"default", {"tension.model=iwasaki2010", "solver.pressure=dfsph"}});

@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <map>
 #include <numbers>
 
 #include "sim/error.h"
 #include "sim/solver.h"
+#include "sim/substance_stage.h"
 #include "sim/tension_stage.h"
 #include "tests/test_support.h"
 
@@ -206,6 +209,169 @@ TEST_F(TensionTest, TheSurfaceForceOnAStillDropAddsUpToLaplaces) {
   const double laplace = 2.0 * 0.0756 / R * 4.0 * std::numbers::pi * R * R;
   EXPECT_NEAR(inward / laplace, 1.0, 0.1);
   EXPECT_LT(std::hypot(net[0], net[1], net[2]) / laplace, 0.01);
+}
+
+// A still drop (as above) whose surface holds a detergent, with the exchange and the surface diffusion off
+// so it stays where it is put: theta = Gamma / Gamma_max on every surface particle (the surface stage's
+// areas), scaled by `shape`(x, y, z) (1: uniform). Returns the state after warm-up with the amounts in place.
+SimState with_detergent(ClRuntime& cl, const Scene& scene, double theta,
+                        const std::function<double(double, double, double)>& shape) {
+  Solver areas(cl, scene, initial_state(scene));
+  areas.warm_up();
+  SimState st = areas.state();
+  HostParticles& p = st.particles;
+  const float* area = p.column("surface_area")->as<float>();
+  HostColumn* col = p.column(adsorbed_field("soap").name);
+  const double dx = scene.spacing, capacity = scene.substances[0].surface_capacity;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (area[i] <= kSurfaceMinArea * dx * dx) continue;
+    const double amount =
+        theta * capacity * area[i] * shape(p.position[i][0], p.position[i][1], p.position[i][2]);
+    col->as<Float2>()[i] = {static_cast<float>(amount), 0.0f};
+  }
+  st.substances.clear();  // the books start from these amounts
+  return st;
+}
+
+Json detergent(double tension_scale, const std::string& law) {
+  return {{"soap",
+           {{"kind", "surface_active"},
+            {"diffusivity", 0.0},
+            {"surface_diffusivity", 0.0},
+            {"adsorption_rate", 0.0},
+            {"desorption_rate", 0.0},
+            {"surface_capacity", 1e-6},
+            {"tension_law", law},
+            {"tension_scale", tension_scale}}}};
+}
+
+// Each particle's position and force over the second step [N], by id (the first step renews the tension
+// ratios from the detergent).
+struct Pull {
+  Eigen::Vector3d x, f;
+};
+std::map<std::uint32_t, Pull> second_step_forces(ClRuntime& cl, const Scene& scene, const SimState& st) {
+  Solver s(cl, scene, st);
+  s.step();
+  const HostParticles a = s.particles();
+  const double t1 = s.time();
+  s.step();
+  const HostParticles b = s.particles();
+  const double dt = s.time() - t1;
+  std::map<std::uint32_t, Eigen::Vector3d> before;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    before[a.id[i]] = Eigen::Vector3d(a.velocity[i][0], a.velocity[i][1], a.velocity[i][2]);
+  std::map<std::uint32_t, Pull> out;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const Eigen::Vector3d v(b.velocity[i][0], b.velocity[i][1], b.velocity[i][2]);
+    out[b.id[i]] = {Eigen::Vector3d(b.position[i][0], b.position[i][1], b.position[i][2]),
+                    double(b.position[i][3]) * (v - before.at(b.id[i])) / dt};
+  }
+  return out;
+}
+
+// Szyszkowski's law with E = sigma0 / (2 ln 2) at half coverage halves the tension: the drop's pull towards
+// its centre over the second step falls by half of Laplace's (the first step is the same in both runs, so
+// everything but the tension cancels in the difference).
+TEST_F(TensionTest, ADetergentLowersTheLaplacePullBySzyszkowskisLaw) {
+  Json doc = block_scene({{"model", "brackbill1992"}});
+  doc["fluids"] = Json::parse(R"([{"material": "water", "shape": "sphere", "centre": [0, 0, 0],
+                                   "radius": 0.008}])");
+  doc["domain"] = Json::parse(R"({"min": [-0.012, -0.012, -0.012], "max": [0.012, 0.012, 0.012]})");
+  doc["solver"]["max_dt"] = 1e-6;
+  const double sigma0 = 0.0756, E = sigma0 / (2.0 * std::log(2.0));
+  doc["substances"] = detergent(0.0, "szyszkowski");
+  const Scene plain = scene_from_json(doc);
+  doc["substances"] = detergent(E, "szyszkowski");
+  const Scene lowered = scene_from_json(doc);
+  const SimState st = with_detergent(cl(), plain, 0.5, [](double, double, double) { return 1.0; });
+  const auto fp = second_step_forces(cl(), plain, st), fl = second_step_forces(cl(), lowered, st);
+  double less = 0;  // how much weaker the pull towards the centre is
+  for (const auto& [id, l] : fl) {
+    const double r = l.x.norm();
+    if (r > 0) less += (l.f - fp.at(id).f).dot(l.x) / r;
+  }
+  const double R = std::cbrt(3.0 * double(fl.size()) / (4.0 * std::numbers::pi)) * 0.001;
+  const double laplace = 2.0 * sigma0 / R * 4.0 * std::numbers::pi * R * R;
+  std::printf("[ info ] the pull fell by %.4g N against half of Laplace's %.4g N\n", less, 0.5 * laplace);
+  EXPECT_NEAR(less / (0.5 * laplace), 1.0, 0.12);
+}
+
+// Marangoni's stress: a flat layer of water (periodic along y and z, on a plane) whose surface holds a
+// detergent varying as 1 + eps sin(k y) along it, under the linear law. The second step's forces along y,
+// less those of the same layer with the detergent spread evenly, add up to the surface gradient of sigma
+// over the surface: sum_i f_y,i cos(k y_i) = int dsigma/dy cos(k y) dA = -E theta eps k L_y L_z / 2.
+TEST_F(TensionTest, AnUnevenDetergentPullsTheSurfaceTowardTheHigherTension) {
+  Json doc = block_scene({{"model", "brackbill1992"}});
+  const double L = 0.012;
+  doc["domain"] = {{"min", {-0.004, 0.0, 0.0}}, {"max", {0.012, L, L}}};
+  doc["solver"]["periodic"] = {"y", "z"};
+  doc["solver"]["max_dt"] = 1e-6;
+  doc["solids"] = Json::parse(R"([{"shape": "plane", "material": "glass", "point": [0, 0, 0],
+                                   "normal": [1, 0, 0]}])");
+  doc["materials"]["glass"] = {
+      {"kind", "solid"}, {"density", 2500}, {"conductivity", 1}, {"specific_heat", 800}};
+  doc["fluids"] = {{{"material", "water"}, {"box", {{"min", {0.0, 0.0, 0.0}}, {"max", {0.005, L, L}}}}}};
+  const double sigma0 = 0.0756, E = 0.02, theta = 0.5, eps = 0.5, k = 2.0 * std::numbers::pi / L;
+  doc["substances"] = detergent(E, "linear");
+  const Scene scene = scene_from_json(doc);
+  const SimState even = with_detergent(cl(), scene, theta, [](double, double, double) { return 1.0; });
+  const SimState uneven = with_detergent(
+      cl(), scene, theta, [&](double, double y, double) { return 1.0 + eps * std::sin(k * y); });
+  const auto fe = second_step_forces(cl(), scene, even), fu = second_step_forces(cl(), scene, uneven);
+  double along = 0;
+  for (const auto& [id, u] : fu) along += (u.f.y() - fe.at(id).f.y()) * std::cos(k * u.x.y());
+  const double expected = -E * theta * eps * k * L * L / 2.0;
+  std::printf("[ info ] Marangoni: %.4g N against %.4g N (sigma0 %.4g N/m)\n", along, expected, sigma0);
+  EXPECT_NEAR(along / expected, 1.0, 0.15);
+}
+
+// The pair models scale a pair's cohesion by the mean of its two tensions, so a detergent spread unevenly
+// over the block (Gamma rising along z) lowers the tension where it sits and still moves no momentum.
+TEST_F(TensionTest, PairForcesUnderAnUnevenDetergentMoveNoMomentum) {
+  for (const char* model : {"akinci2013", "iwasaki2010"}) {
+    Json doc = block_scene({{"model", model}}, "dfsph");
+    doc["substances"] = detergent(0.03, "szyszkowski");
+    const Scene scene = scene_from_json(doc);
+    const SimState st =
+        with_detergent(cl(), scene, 0.45, [](double, double, double z) { return 1.0 + 80.0 * z; });
+    Solver s(cl(), scene, st);
+    for (int k = 0; k < 60; ++k) s.step();
+    const HostParticles p = s.particles();
+    const float* ratio = p.column(kTensionRatioField)->as<float>();
+    double momentum[3] = {0, 0, 0}, scale = 0, lowest = 1;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double m = p.position[i][3];
+      lowest = std::min(lowest, double(ratio[i]));
+      for (int a = 0; a < 3; ++a) momentum[a] += m * p.velocity[i][a];
+      scale += m * std::sqrt(p.velocity[i][0] * p.velocity[i][0] + p.velocity[i][1] * p.velocity[i][1] +
+                             p.velocity[i][2] * p.velocity[i][2]);
+    }
+    ASSERT_GT(scale, 0) << model << ": the tension moved nothing";
+    EXPECT_LT(lowest, 0.9) << model << ": the detergent lowered no particle's tension";
+    EXPECT_LT(std::hypot(momentum[0], momentum[1], momentum[2]) / scale, 1e-4) << model;
+  }
+}
+
+// Szyszkowski's and the linear law are written in Gamma / Gamma_max: with tension on, a detergent without a
+// capacity is refused at its law's path; without tension, or with the law off, it is taken.
+TEST(TensionScene, ATensionLawNeedsASurfaceCapacity) {
+  Json doc = block_scene({{"model", "brackbill1992"}});
+  doc["substances"] = detergent(0.01, "linear");
+  doc["substances"]["soap"]["surface_capacity"] = 0.0;
+  try {
+    scene_from_json(doc);
+    ADD_FAILURE() << "a tension law without a capacity was taken";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path(), "substances.soap.tension_law");
+  }
+  doc["substances"]["soap"]["tension_law"] = "none";
+  EXPECT_NO_THROW(scene_from_json(doc));
+  doc["substances"]["soap"]["tension_law"] = "linear";
+  doc["tension"]["model"] = "none";
+  EXPECT_NO_THROW(scene_from_json(doc));
+  doc["substances"]["soap"]["tension_law"] = "langmuir";
+  EXPECT_THROW(scene_from_json(doc), SceneError);
 }
 
 }  // namespace
