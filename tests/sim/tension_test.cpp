@@ -10,6 +10,7 @@
 
 #include "sim/error.h"
 #include "sim/solver.h"
+#include "sim/state_file.h"
 #include "sim/substance_stage.h"
 #include "sim/tension_stage.h"
 #include "tests/test_support.h"
@@ -372,6 +373,27 @@ TEST(TensionScene, ATensionLawNeedsASurfaceCapacity) {
   EXPECT_NO_THROW(scene_from_json(doc));
   doc["substances"]["soap"]["tension_law"] = "langmuir";
   EXPECT_THROW(scene_from_json(doc), SceneError);
+}
+
+// The tension ratios are saved: a run resumed mid-way with a detergent lowering the tension goes on bit for
+// bit (the first step's tension pass reads the ratios the straight run's last step left).
+TEST_F(TensionTest, ARunWithALoweredTensionResumesBitwise) {
+  Json doc = block_scene({{"model", "brackbill1992"}});
+  doc["substances"] = detergent(0.03, "szyszkowski");
+  doc["substances"]["soap"]["adsorption_rate"] = 1e-4;
+  doc["substances"]["soap"]["desorption_rate"] = 1.0;
+  const Scene scene = scene_from_json(doc);
+  const SimState start =
+      with_detergent(cl(), scene, 0.4, [](double, double, double z) { return 1.0 + 60.0 * z; });
+  testing::TempDir dir("tension-resume");
+  Solver straight(cl(), scene, start);
+  for (int i = 0; i < 12; ++i) straight.step();
+  write_state_file(dir / "half.state", straight.state());
+  for (int i = 0; i < 10; ++i) straight.step();
+  const std::string expected = testing::state_file_bytes(straight.state(), dir, "straight.state");
+  Solver resumed(cl(), scene, read_state_file(dir / "half.state"));
+  while (resumed.steps() < straight.steps()) resumed.step();
+  EXPECT_TRUE(testing::state_file_bytes(resumed.state(), dir, "resumed.state") == expected);
 }
 
 }  // namespace
