@@ -415,10 +415,15 @@ function aimAt(e) {
   send('dryer.aim', { dryer: currentDryer(), x: e.offsetX * sx, y: e.offsetY * sy });
 }
 
-// How much of the chosen substance the scene holds, and how much was dropped or poured in.
+// How much of the chosen substance the scene holds, and how much was dropped or poured in; of what it holds,
+// how much sits on the water's surface (a detergent) and on solids and ice (a coating), where it can.
 function showSubstance() {
   const b = substanceBooks[$('substance').value];
-  $('substance-total').textContent = b ? `${(1e3 * b.total).toPrecision(3)} g held, ${(1e3 * b.inflow).toPrecision(3)} g added` : '';
+  const grams = (kg) => (1e3 * kg).toPrecision(3);
+  let text = b ? `${grams(b.total)} g held, ${grams(b.inflow)} g added` : '';
+  if (b && b.on_surface > 0) text += `; ${grams(b.on_surface)} g on the surface`;
+  if (b && b.on_solids > 0) text += `; ${grams(b.on_solids)} g on solids and ice`;
+  $('substance-total').textContent = text;
 }
 $('substance').addEventListener('change', showSubstance);
 

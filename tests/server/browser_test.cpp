@@ -191,6 +191,36 @@ async def scenario(call, js, until):
   EXPECT_TRUE(served.stop()) << served.log();
 }
 
+// The Substances panel says where a coating is (issue 20): in wash-the-plate, with the grease chosen, its
+// line counts what sticks to the plate; with the detergent chosen, what sits on the water's surface.
+TEST(BrowserClient, TheSubstancesPanelSaysWhatSticksToSolids) {
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium"))
+      << "Debian's chromium is not installed (scripts/setup)";
+  TempDir dir("browser-coating");
+  ServedScene served(dir, "wash-the-plate --set spacing=0.005 --state-dir states");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(in_chromium(R"py(
+TOTAL = "document.getElementById('substance-total').textContent"
+async def scenario(call, js, until):
+    print("panel", await until("!document.getElementById('substances').hidden && substances.length === 2", 30))
+    print("books", bool(await until("substanceBooks.grease && substanceBooks.grease.on_solids > 0", 30)))
+    await js("{ const s = document.getElementById('substance'); s.value = 'grease'; s.dispatchEvent(new Event('change')); }")
+    print("on solids", bool(await until(f"/g on solids and ice/.test({TOTAL})", 20)))
+    print("[ info ] " + await js(TOTAL))
+    await js("{ const s = document.getElementById('substance'); s.value = 'detergent'; s.dispatchEvent(new Event('change')); }")
+    print("on surface", bool(await until(f"/g on the surface/.test({TOTAL}) && !/on solids/.test({TOTAL})", 20)))
+    print("[ info ] " + await js(TOTAL))
+)py"),
+                                            240, &status);
+  EXPECT_EQ(status, 0) << out;
+  expect_lines(out, {"connected True", "panel True", "books True", "on solids True", "on surface True",
+                     "screenshot True"});
+  for (std::size_t at = out.find("[ info ]"); at != std::string::npos; at = out.find("[ info ]", at + 1))
+    std::printf("%s\n", out.substr(at, out.find('\n', at) - at).c_str());
+  EXPECT_TRUE(served.stop()) << served.log();
+}
+
 // An air scene's page (issue 18): the readout says how much air there is and how warm (the dryer's jet
 // shows in the air's top temperature), and calls what comes in and goes out what it is, air, not water
 // poured; the readout's lines stay within the picture.
