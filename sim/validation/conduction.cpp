@@ -22,7 +22,10 @@ Field params() {
       "",
       {
           number("sigma0", "Initial width s0 of the pulse").in("m").def(0.01).above(0),
-          number("variance_growth", "Run until s0^2 + 2 alpha t = (1 + this) s0^2").def(1.0).above(0).at_most(20),
+          number("variance_growth", "Run until s0^2 + 2 alpha t = (1 + this) s0^2")
+              .def(1.0)
+              .above(0)
+              .at_most(20),
           number("half_width", "Half-width of the cubic domain, in final pulse widths sqrt(s0^2 + 2 alpha t)")
               .def(4.0)
               .at_least(2)
@@ -39,8 +42,12 @@ Field params() {
           integer("seed", "Random seed of the jitter").def(1).at_least(0),
           number("l2_gate", "Gate on the L2 error of T - T_inf on ordered particles").def(0.01).above(0),
           number("l2_gate_jittered", "The same with jitter > 0").def(0.03).above(0),
-          number("diffusivity_gate", "Gate on the relative error of the effective diffusivity").def(0.03).above(0),
-          number("energy_gate", "Gate on the energy closure, relative to the pulse's heat").def(1e-5).above(0),
+          number("diffusivity_gate", "Gate on the relative error of the effective diffusivity")
+              .def(0.03)
+              .above(0),
+          number("energy_gate", "Gate on the energy closure, relative to the pulse's heat")
+              .def(1e-5)
+              .above(0),
           solver_schema_with({{"flow", false}, {"max_dt", 3600.0}}),
       });
 }
@@ -69,8 +76,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
       {"solver", settings},
       {"ambient", {{"heat_transfer_coefficient", 0.0}}},
       {"materials",
-       {{"medium",
-         {{"kind", "fluid"}, {"density", rho}, {"conductivity", k}, {"specific_heat", c}}}}},
+       {{"medium", {{"kind", "fluid"}, {"density", rho}, {"conductivity", k}, {"specific_heat", c}}}}},
       {"fluids", {{{"material", "medium"}, {"box", {{"min", {-L, -L, -L}}, {"max", {L, L, L}}}}}}},
   };
   const Scene scene = scene_from_json(doc);
@@ -82,7 +88,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (jitter > 0)
       for (int a = 0; a < 3; ++a) p.position[i][a] += static_cast<float>(shift(rng));
-    const double r2 = double(p.position[i][0]) * p.position[i][0] + double(p.position[i][1]) * p.position[i][1] +
+    const double r2 = double(p.position[i][0]) * p.position[i][0] +
+                      double(p.position[i][1]) * p.position[i][1] +
                       double(p.position[i][2]) * p.position[i][2];
     const double h = enthalpy_at(scene, p.material[i], pulse.temperature(r2, 0.0));
     const float hi = static_cast<float>(h);
@@ -104,12 +111,14 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double t = solver.time();
   double heat = 0;
   for (std::size_t i = 0; i < q.size(); ++i) {
-    const double r2 = double(q.position[i][0]) * q.position[i][0] + double(q.position[i][1]) * q.position[i][1] +
+    const double r2 = double(q.position[i][0]) * q.position[i][0] +
+                      double(q.position[i][1]) * q.position[i][1] +
                       double(q.position[i][2]) * q.position[i][2];
     heat += double(q.position[i][3]) * c * std::abs(pulse.temperature(r2, t) - pulse.background);
   }
   const double alpha_eff = (pulse.second_moment(q.position, T) - m2_start) / (2.0 * 3.0 * t);
-  const double closure = solver.total_enthalpy() - solver.energy_budget().initial - solver.energy_budget().heat_in();
+  const double closure =
+      solver.total_enthalpy() - solver.energy_budget().initial - solver.energy_budget().heat_in();
 
   CaseResult r;
   r.particles = q.size();
@@ -117,7 +126,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   r.wall_s = wall;
   const double l2 = pulse.l2_error(q.position, T, t);
   r.metrics = {
-      {"temperature_l2", {l2, 0.0, l2, jitter > 0 ? double(prm["l2_gate_jittered"]) : double(prm["l2_gate"])}},
+      {"temperature_l2",
+       {l2, 0.0, l2, jitter > 0 ? double(prm["l2_gate_jittered"]) : double(prm["l2_gate"])}},
       {"effective_diffusivity",
        {alpha_eff, pulse.diffusivity, std::abs(alpha_eff - pulse.diffusivity) / pulse.diffusivity,
         prm["diffusivity_gate"]}},

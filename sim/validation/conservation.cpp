@@ -199,7 +199,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
     std::fprintf(
         stderr,
         "conservation: melted %zu, froze %zu, poured %llu, out %llu particles (of %zu ice); paint on "
-        "ice %g kg at most, on the plate %g kg of %g\n",
+        "ice %g kg at most, on the tile %g kg of %g\n",
         melted, frozen, (unsigned long long)solver.inflow().particles,
         (unsigned long long)solver.outflow().particles, ice0, on_ice, on_tile, on_tile_start);
 

@@ -35,35 +35,38 @@ double martin_moyce(double t_star) {
 
 Field params() {
   return object(
-      "", {
-              number("width", "Column width a").in("m").def(0.05715).above(0),
-              number("height_ratio", "Column height / a (Martin & Moyce's data are for 2)").def(2.0).above(0),
-              number("length_ratio", "Tank length / a").def(5.0).above(1),
-              integer("depth_particles", "Tank depth (y) in particle spacings; walls there are free-slip")
-                  .def(4)
-                  .at_least(1),
-              number("gravity", "Gravitational acceleration g").in("m/s^2").def(9.81).above(0),
-              number("density", "Rest density").in("kg/m^3").def(1000.0).above(0),
-              number("viscosity", "Dynamic viscosity").in("Pa s").def(1.0e-3).at_least(0),
-              number("t_star_min", "Start of the compared window in T* = t sqrt(2g/a)").def(1.0).at_least(0),
-              number("t_star_max", "End of the compared window in T*").def(3.0).above(0),
-              number("gate", "Gate on the front's speed dZ/dT* over the window against the data's").def(0.10).above(0),
-              number("shift_min", "Least start-time shift dT* allowed (the simulated front may not lag the data)")
-                  .def(0.0),
-              number("shift_max",
-                     "Largest start-time shift dT* allowed (Martin & Moyce's gate took time to open: the data "
-                     "lag an instant release)")
-                  .def(0.3),
-              number("shifted_gate", "Gate on |Z - Z_ref| / Z_ref at each compared time, after the shift")
-                  .def(0.05)
-                  .above(0),
-              choice("bed", {"free-slip", "no-slip"},
-                     "The tank's floor and walls: free-slip, or no-slip (the walls take the fluid's viscosity: "
-                     "solver.boundary_viscosity = solver.artificial_viscosity), since the bed's friction sets "
-                     "the experiments' front speed")
-                  .def("free-slip"),
-              solver_schema_with({{"artificial_viscosity", 0.02}}),
-          });
+      "",
+      {
+          number("width", "Column width a").in("m").def(0.05715).above(0),
+          number("height_ratio", "Column height / a (Martin & Moyce's data are for 2)").def(2.0).above(0),
+          number("length_ratio", "Tank length / a").def(5.0).above(1),
+          integer("depth_particles", "Tank depth (y) in particle spacings; walls there are free-slip")
+              .def(4)
+              .at_least(1),
+          number("gravity", "Gravitational acceleration g").in("m/s^2").def(9.81).above(0),
+          number("density", "Rest density").in("kg/m^3").def(1000.0).above(0),
+          number("viscosity", "Dynamic viscosity").in("Pa s").def(1.0e-3).at_least(0),
+          number("t_star_min", "Start of the compared window in T* = t sqrt(2g/a)").def(1.0).at_least(0),
+          number("t_star_max", "End of the compared window in T*").def(3.0).above(0),
+          number("gate", "Gate on the front's speed dZ/dT* over the window against the data's")
+              .def(0.10)
+              .above(0),
+          number("shift_min", "Least start-time shift dT* allowed (the simulated front may not lag the data)")
+              .def(0.0),
+          number("shift_max",
+                 "Largest start-time shift dT* allowed (Martin & Moyce's gate took time to open: the data "
+                 "lag an instant release)")
+              .def(0.3),
+          number("shifted_gate", "Gate on |Z - Z_ref| / Z_ref at each compared time, after the shift")
+              .def(0.05)
+              .above(0),
+          choice("bed", {"free-slip", "no-slip"},
+                 "The tank's floor and walls: free-slip, or no-slip (the walls take the fluid's viscosity: "
+                 "solver.boundary_viscosity = solver.artificial_viscosity), since the bed's friction sets "
+                 "the experiments' front speed")
+              .def("free-slip"),
+          solver_schema_with({{"artificial_viscosity", 0.02}}),
+      });
 }
 
 CaseResult run(ClRuntime& cl, const Json& prm, int res) {
@@ -74,7 +77,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double L = double(prm["length_ratio"]) * a, Hc = double(prm["height_ratio"]) * a;
   const double depth = int(prm["depth_particles"]) * dx;
   Json solver_settings = prm["solver"];
-  if (prm["bed"] == "no-slip") solver_settings["boundary_viscosity"] = solver_settings["artificial_viscosity"];
+  if (prm["bed"] == "no-slip")
+    solver_settings["boundary_viscosity"] = solver_settings["artificial_viscosity"];
   const Json doc = tank_scene_json({"validation/dam-break",
                                     {L, depth, 1.25 * Hc},
                                     {a, depth, Hc},

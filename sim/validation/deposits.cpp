@@ -10,13 +10,12 @@
 //     deposits (k_c = 0). The cleanser is not used up (sec. 6.3's micelles take both into the water), so
 //     every face loses its deposit at k_r c_D: Gamma(t) = Gamma0 exp(-k_r c_D t) whatever the water does
 //     with the grease. Metrics: the rate fitted to ln(deposit) through the origin; the closure.
-#include <chrono>
 #include <cmath>
 
 #include "sim/error.h"
 #include "sim/solver.h"
 #include "sim/substance_stage.h"
-#include "sim/validation/case.h"
+#include "sim/validation/substance_cases.h"
 
 namespace thaw {
 namespace {
@@ -25,22 +24,14 @@ constexpr const char* kCoating = "coating";
 constexpr const char* kCleanser = "cleanser";
 
 Field layer_params(std::vector<Field> own) {
-  std::vector<Field> f = {
-      number("depth", "L, the depth of the water on the plane").in("m").def(0.004).above(0),
-      number("density", "rho of water").in("kg/m^3").def(1000.0).above(0),
-  };
-  for (Field& x : own) f.push_back(std::move(x));
-  f.push_back(solver_schema_with({{"flow", false}, {"max_dt", 3600.0}}));
-  f.push_back(
-      number("closure_gate", "Gate on the coating's closure, relative to its total").def(1e-9).above(0));
-  return object("", std::move(f));
+  return held_case_params(
+      number("depth", "L, the depth of the water on the plane").in("m").def(0.004).above(0), std::move(own));
 }
 
 // The layer: water [0, L) deep over a plane at z = 0, 6 spacings along the periodic x and y.
 Scene layer_scene(const std::string& name, const Json& prm, int res, const Json& substances,
                   const Json& water_substances, const Json& deposits) {
-  if (prm["solver"]["flow"].get<bool>())
-    throw SceneError("solver.flow", "the coating cases hold particles in place: they need flow = false");
+  require_held(prm, "the coating cases");
   const double L = prm["depth"], dx = L / res, side = 6 * dx;
   Json solver = prm["solver"];
   solver["periodic"] = {"x", "y"};
@@ -68,57 +59,6 @@ Scene layer_scene(const std::string& name, const Json& prm, int res, const Json&
          {"box", {{"min", {0.0, 0.0, 0.0}}, {"max", {side, side, L}}}},
          {"substances", water_substances}}}},
   });
-}
-
-double amount(const Float2& q) { return double(q[0]) + double(q[1]); }
-
-// What `field` holds over all particles [kg].
-double field_total(const Solver& solver, const std::string& field) {
-  const HostParticles p = solver.particles();
-  const HostColumn* c = p.column(field);
-  double sum = 0;
-  if (c)
-    for (std::size_t i = 0; i < p.size(); ++i) sum += amount(c->as<Float2>()[i]);
-  return sum;
-}
-
-// Steps to t_end, stopping at `samples` even times to call at(time); the wall seconds spent stepping.
-template <class F>
-double run_sampled(Solver& solver, double t_end, int samples, F at) {
-  double wall = 0;
-  for (int n = 1; n <= samples; ++n) {
-    const auto w0 = std::chrono::steady_clock::now();
-    while (solver.time() < t_end * n / samples * (1.0 - 1e-12)) solver.step();
-    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-    at(solver.time());
-  }
-  return wall;
-}
-
-// The least-squares slope of y against t (with an intercept unless through_origin).
-double slope(const std::vector<double>& t, const std::vector<double>& y, bool through_origin) {
-  const double n = double(t.size());
-  double st = 0, sy = 0, stt = 0, sty = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    st += t[k], sy += y[k], stt += t[k] * t[k], sty += t[k] * y[k];
-  }
-  if (through_origin) return stt > 0 ? sty / stt : 0.0;
-  const double d = n * stt - st * st;
-  return d != 0 ? (n * sty - st * sy) / d : 0.0;
-}
-
-CaseResult result_of(const Solver& solver, double wall,
-                     std::vector<std::pair<std::string, MetricResult>> metrics, const Json& prm,
-                     std::size_t substance) {
-  CaseResult r;
-  r.particles = solver.size();
-  r.steps = solver.steps();
-  r.wall_s = wall;
-  r.metrics = std::move(metrics);
-  const double initial = solver.substance_books().initial.at(substance);
-  const double closure = solver.substance_totals().at(substance) - initial;
-  r.metrics.push_back({"closure", {closure, 0.0, std::abs(closure) / initial, prm["closure_gate"]}});
-  return r;
 }
 
 // The first root of lambda tan(lambda) = bi in (0, pi / 2), by bisection.
@@ -169,10 +109,10 @@ CaseResult run_coating(ClRuntime& cl, const Json& prm, int res) {
   });
   // The second half: the layer's higher modes decay at (pi / L)^2 D and faster, gone by then.
   const std::vector<double> t2(t.begin() + samples / 2, t.end()), y2(y.begin() + samples / 2, y.end());
-  const double fitted = slope(t2, y2, false);
-  return result_of(solver, wall,
-                   {{"decay_rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}}}, prm,
-                   0);
+  const double fitted = least_squares_line(t2, y2).slope;
+  return substance_case_result(
+      solver, wall, {{"decay_rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}}},
+      prm["closure_gate"]);
 }
 
 Field cleansing_params() {
@@ -215,9 +155,10 @@ CaseResult run_cleansing(ClRuntime& cl, const Json& prm, int res) {
     t.push_back(time);
     y.push_back(-std::log(std::max(field_total(solver, stuck) / r0, 1e-300)));
   });
-  const double fitted = slope(t, y, true);
-  return result_of(solver, wall, {{"rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}}},
-                   prm, 0);
+  const double fitted = slope_through_origin(t, y);
+  return substance_case_result(solver, wall,
+                               {{"rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}}},
+                               prm["closure_gate"]);
 }
 
 }  // namespace

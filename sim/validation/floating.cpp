@@ -161,7 +161,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double margin = snap(double(prm["margin"]) * H), depth = snap(double(prm["depth"]) * H);
   const double W = std::max(b, h) + 2 * margin;
   const double x0 = 0.5 * (W - b);  // the prism's base, centred
-  const double level = depth;  // the water's top before the ice goes in
+  const double level = depth;       // the water's top before the ice goes in
   // Centre at the reference draft: bottom f h below the level.
   const double bottom = level - f * h;
   const Eigen::Vector3d lo(x0, x0, bottom), hi(x0 + b, x0 + b, bottom + h);

@@ -155,7 +155,8 @@ double GaussianPulse::second_moment(const std::vector<Float4>& x, const std::vec
   return m2 / m0;
 }
 
-double GaussianPulse::l2_error(const std::vector<Float4>& x, const std::vector<double>& value, double t) const {
+double GaussianPulse::l2_error(const std::vector<Float4>& x, const std::vector<double>& value,
+                               double t) const {
   double err2 = 0, ref2 = 0;
   for (std::size_t i = 0; i < x.size(); ++i) {
     const double exact = temperature(radius2(x[i]), t);

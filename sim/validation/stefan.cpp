@@ -35,7 +35,10 @@ Field params() {
           number("water_specific_heat", "c of water").in("J/kg/K").def(4217.0).above(0),
           number("ice_conductivity", "k of ice").in("W/m/K").def(2.22).above(0),
           number("ice_specific_heat", "c of ice").in("J/kg/K").def(2050.0).above(0),
-          integer("cross_section", "Particles across the periodic y and z extent").def(6).at_least(6).at_most(64),
+          integer("cross_section", "Particles across the periodic y and z extent")
+              .def(6)
+              .at_least(6)
+              .at_most(64),
           number("far_length", "Slab length beyond the front, in diffusion lengths sqrt(alpha_far t)")
               .def(4.0)
               .at_least(1),
@@ -50,8 +53,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double L = prm["latent_heat"], rho = prm["density"], t_end = prm["time"];
   const ThermalPhase water{prm["water_conductivity"], prm["water_specific_heat"], rho};
   const ThermalPhase ice{prm["ice_conductivity"], prm["ice_specific_heat"], rho};
-  if (Tw == Tm)
-    throw SceneError("wall_temperature", "equals the melting point: nothing melts or freezes");
+  if (Tw == Tm) throw SceneError("wall_temperature", "equals the melting point: nothing melts or freezes");
   const bool melting = Tw > Tm;
   if (melting && T0 > Tm)
     throw SceneError("initial_temperature", "melting needs ice at or below the melting point");
@@ -62,8 +64,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   const double s_end = ref.front(t_end);
   const double dx = s_end / res;
   // An isothermal far side (T0 = T_m) has no diffusion to contain: a few spacings past the front do.
-  const double far_len = T0 == Tm ? 0.5 * s_end + 4 * dx
-                                  : double(prm["far_length"]) * std::sqrt(far.diffusivity() * t_end);
+  const double far_len =
+      T0 == Tm ? 0.5 * s_end + 4 * dx : double(prm["far_length"]) * std::sqrt(far.diffusivity() * t_end);
   const double length = std::ceil((s_end + far_len) / dx) * dx;
   const double W = int(prm["cross_section"]) * dx;
   const Json settings = prm["solver"];
@@ -152,10 +154,11 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
 }  // namespace
 
 ValidationCase stefan_case() {
-  return {"stefan",
-          "melting or freezing slab against Neumann's solution: front within 2 %, energy balance within 0.1 %; "
-          "res = particles across the front",
-          20, params, run};
+  return {
+      "stefan",
+      "melting or freezing slab against Neumann's solution: front within 2 %, energy balance within 0.1 %; "
+      "res = particles across the front",
+      20, params, run};
 }
 
 }  // namespace thaw

@@ -13,13 +13,12 @@
 //     Gamma = Gamma0 + Gamma1 cos(theta); its l = 1 part decays as Gamma1 exp(-2 D_s t / R^2) (the surface
 //     Laplacian's eigenvalue l (l + 1) / R^2). Metrics: the decay rate fitted to the l = 1 amplitude's log
 //     (Gamma1 from the particles by least squares, sum S_i cos / sum a_i cos^2), and the closure.
-#include <chrono>
 #include <cmath>
 
 #include "sim/error.h"
 #include "sim/solver.h"
 #include "sim/substance_stage.h"
-#include "sim/validation/case.h"
+#include "sim/validation/substance_cases.h"
 
 namespace thaw {
 namespace {
@@ -28,23 +27,14 @@ namespace {
 constexpr const char* kSurfactant = "surfactant";
 
 Field sphere_params(std::vector<Field> own) {
-  std::vector<Field> f = {
-      number("radius", "R of the sphere of water").in("m").def(0.005).above(0),
-      number("density", "rho of water").in("kg/m^3").def(1000.0).above(0),
-  };
-  for (Field& x : own) f.push_back(std::move(x));
-  f.push_back(solver_schema_with({{"flow", false}, {"max_dt", 3600.0}}));
-  f.push_back(
-      number("closure_gate", "Gate on the substance's closure, relative to its total").def(1e-9).above(0));
-  return object("", std::move(f));
+  return held_case_params(number("radius", "R of the sphere of water").in("m").def(0.005).above(0),
+                          std::move(own));
 }
 
 // The held sphere with `substance` (its schema fields) and its concentration in the water.
 Scene sphere_scene(const std::string& name, const Json& prm, int res, const Json& substance,
                    double concentration) {
-  if (prm["solver"]["flow"].get<bool>())
-    throw SceneError("solver.flow",
-                     "the surface transport cases hold particles in place: they need flow = false");
+  require_held(prm, "the surface transport cases");
   const double R = prm["radius"], dx = R / res, half = R + 3 * dx;
   Json water = {{"material", "water"}, {"shape", "sphere"}, {"centre", {0.0, 0.0, 0.0}}, {"radius", R}};
   if (concentration > 0) water["substances"] = {{kSurfactant, {{"concentration", concentration}}}};
@@ -64,47 +54,6 @@ Scene sphere_scene(const std::string& name, const Json& prm, int res, const Json
       {"substances", {{kSurfactant, substance}}},
       {"fluids", {water}},
   });
-}
-
-double amount(const Float2& q) { return double(q[0]) + double(q[1]); }
-
-// The least-squares slope through the origin of y against t.
-double slope_through_origin(const std::vector<double>& t, const std::vector<double>& y) {
-  double ty = 0, tt = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    ty += t[k] * y[k];
-    tt += t[k] * t[k];
-  }
-  return tt > 0 ? ty / tt : 0.0;
-}
-
-// Steps `solver` to t_end, stopping at `samples` even times to call at(time); returns the wall seconds spent
-// stepping (the measurements between are not the model's cost).
-template <class F>
-double run_sampled(Solver& solver, double t_end, int samples, F at) {
-  double wall = 0;
-  for (int n = 1; n <= samples; ++n) {
-    const auto w0 = std::chrono::steady_clock::now();
-    while (solver.time() < t_end * n / samples * (1.0 - 1e-12)) solver.step();
-    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-    at(solver.time());
-  }
-  return wall;
-}
-
-// The case's result: the run's size, steps and wall time, its own metrics, then the substance's closure
-// (its total now against the start's) relative to the start's.
-CaseResult result_of(const Solver& solver, double wall,
-                     std::vector<std::pair<std::string, MetricResult>> metrics, const Json& prm) {
-  CaseResult r;
-  r.particles = solver.size();
-  r.steps = solver.steps();
-  r.wall_s = wall;
-  r.metrics = std::move(metrics);
-  const double initial = solver.substance_books().initial.at(0);
-  const double closure = solver.substance_totals().at(0) - initial;
-  r.metrics.push_back({"closure", {closure, 0.0, std::abs(closure) / initial, prm["closure_gate"]}});
-  return r;
 }
 
 Field adsorption_params() {
@@ -147,13 +96,7 @@ CaseResult run_adsorption(ClRuntime& cl, const Json& prm, int res) {
   const double k = kd + ka * A / V;
   const double N = solver.substance_totals().at(0);
   const double S_eq = N * (ka * A / V) / k;
-  auto on_surface = [&] {
-    const HostParticles p = solver.particles();
-    const Float2* s = p.column(adsorbed_field(kSurfactant).name)->as<Float2>();
-    double S = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) S += amount(s[i]);
-    return S;
-  };
+  auto on_surface = [&] { return field_total(solver, adsorbed_field(kSurfactant).name); };
 
   std::vector<double> t, y;
   double worst = 0;
@@ -164,10 +107,10 @@ CaseResult run_adsorption(ClRuntime& cl, const Json& prm, int res) {
     y.push_back(-std::log(std::max(1.0 - S / S_eq, 1e-300)));
   });
   const double k_fit = slope_through_origin(t, y);
-  return result_of(solver, wall,
-                   {{"rate", {k_fit, k, std::abs(k_fit - k) / k, prm["rate_gate"]}},
-                    {"surface_amount", {worst, 0.0, worst, prm["amount_gate"]}}},
-                   prm);
+  return substance_case_result(solver, wall,
+                               {{"rate", {k_fit, k, std::abs(k_fit - k) / k, prm["rate_gate"]}},
+                                {"surface_amount", {worst, 0.0, worst, prm["amount_gate"]}}},
+                               prm["closure_gate"]);
 }
 
 Field surface_diffusion_params() {
@@ -226,7 +169,7 @@ CaseResult run_surface_diffusion(ClRuntime& cl, const Json& prm, int res) {
       const Float4& x = now.position[i];
       const double r = std::sqrt(double(x[0]) * x[0] + double(x[1]) * x[1] + double(x[2]) * x[2]);
       const double c = r > 0 ? double(x[2]) / r : 0.0;
-      sc += amount(q[i]) * c;
+      sc += pair_amount(q[i]) * c;
       if (a[i] > kSurfaceMinArea * dx * dx) acc += double(a[i]) * c * c;
     }
     return acc > 0 ? sc / acc : 0.0;
@@ -239,8 +182,9 @@ CaseResult run_surface_diffusion(ClRuntime& cl, const Json& prm, int res) {
     y.push_back(-std::log(std::max(amplitude() / a0, 1e-300)));
   });
   const double fitted = slope_through_origin(t, y);
-  return result_of(solver, wall,
-                   {{"decay_rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}}}, prm);
+  return substance_case_result(
+      solver, wall, {{"decay_rate", {fitted, rate, std::abs(fitted - rate) / rate, prm["rate_gate"]}}},
+      prm["closure_gate"]);
 }
 
 }  // namespace
@@ -258,6 +202,52 @@ ValidationCase surface_diffusion_case() {
           "Surface diffusion on a held sphere: Gamma1 cos(theta) decays at 2 D_s / R^2 (gate 3 %), closure "
           "1e-9; res = spacings across R",
           10, surface_diffusion_params, run_surface_diffusion};
+}
+
+double field_total(const Solver& solver, const std::string& field) {
+  const HostParticles p = solver.particles();
+  const HostColumn* c = p.column(field);
+  double sum = 0;
+  for (std::size_t i = 0; c && i < p.size(); ++i) sum += pair_amount(c->as<Float2>()[i]);
+  return sum;
+}
+
+double slope_through_origin(const std::vector<double>& t, const std::vector<double>& y) {
+  double ty = 0, tt = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    ty += t[k] * y[k];
+    tt += t[k] * t[k];
+  }
+  return tt > 0 ? ty / tt : 0.0;
+}
+
+CaseResult substance_case_result(const Solver& solver, double wall,
+                                 std::vector<std::pair<std::string, MetricResult>> metrics, double gate,
+                                 std::size_t substance) {
+  CaseResult r;
+  r.particles = solver.size();
+  r.steps = solver.steps();
+  r.wall_s = wall;
+  r.metrics = std::move(metrics);
+  const double initial = solver.substance_books().initial.at(substance);
+  const double closure = solver.substance_totals().at(substance) - initial;
+  r.metrics.push_back({"closure", {closure, 0.0, std::abs(closure) / initial, gate}});
+  return r;
+}
+
+Field held_case_params(Field size, std::vector<Field> own) {
+  std::vector<Field> f = {std::move(size),
+                          number("density", "rho of water").in("kg/m^3").def(1000.0).above(0)};
+  for (Field& x : own) f.push_back(std::move(x));
+  f.push_back(solver_schema_with({{"flow", false}, {"max_dt", 3600.0}}));
+  f.push_back(
+      number("closure_gate", "Gate on the substance's closure, relative to its total").def(1e-9).above(0));
+  return object("", std::move(f));
+}
+
+void require_held(const Json& params, const std::string& cases) {
+  if (params["solver"]["flow"].get<bool>())
+    throw SceneError("solver.flow", cases + " hold particles in place: they need flow = false");
 }
 
 }  // namespace thaw

@@ -24,7 +24,10 @@ Json tank_scene_json(const TankScene& t) {
           {"conductivity", 0.56},
           {"specific_heat", 4217.0}}},
         {"wall", {{"kind", "solid"}, {"density", 2500.0}, {"conductivity", 1.0}, {"specific_heat", 840.0}}}}},
-      {"fluids", {{{"material", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", vec(t.water)}}}, {"temperature", 30.0}}}},
+      {"fluids",
+       {{{"material", "water"},
+         {"box", {{"min", {0, 0, 0}}, {"max", vec(t.water)}}},
+         {"temperature", 30.0}}}},
   };
 }
 
