@@ -346,23 +346,24 @@ void check_start(const Scene& s, int material, double T, const std::string& path
                                "); supercooled fluid is not modelled");
 }
 
+// The index in s.substances of the substance called `name`, which a scene names at `path`; a SceneError
+// there, listing what the scene declares, if it declares none of that name.
+std::size_t substance_index(const Scene& s, const std::string& name, const std::string& path) {
+  for (std::size_t k = 0; k < s.substances.size(); ++k)
+    if (s.substances[k].name == name) return k;
+  std::string known;
+  for (const Substance& d : s.substances) known += (known.empty() ? "" : ", ") + d.name;
+  throw SceneError(path, "the scene's `substances` declare no substance '" + name + "' (" +
+                             (known.empty() ? "it declares none" : "it declares " + known) + ")");
+}
+
 // The concentration of each of the scene's substances [kg/m^3] that a fluid block or an emitter (`entry`, at
 // `path`) gives in its `substances`; 0 for those it does not name.
 std::vector<double> concentrations_from_json(const Json& entry, const std::string& path, const Scene& s) {
   std::vector<double> out(s.substances.size(), 0.0);
   if (!entry.contains("substances")) return out;
-  for (const auto& [name, value] : entry["substances"].items()) {
-    const auto it = std::find_if(s.substances.begin(), s.substances.end(),
-                                 [&](const Substance& d) { return d.name == name; });
-    if (it == s.substances.end()) {
-      std::string known;
-      for (const Substance& d : s.substances) known += (known.empty() ? "" : ", ") + d.name;
-      throw SceneError(path + ".substances." + name,
-                       "the scene's `substances` declare no substance of this name (" +
-                           (known.empty() ? "it declares none" : "it declares " + known) + ")");
-    }
-    out[static_cast<std::size_t>(it - s.substances.begin())] = value["concentration"].get<double>();
-  }
+  for (const auto& [name, value] : entry["substances"].items())
+    out[substance_index(s, name, path + ".substances." + name)] = value["concentration"].get<double>();
   return out;
 }
 
@@ -446,14 +447,11 @@ Solid solid_from_json(Json& j, const std::string& path, const Scene& s, const Js
   solid.deposits.assign(s.substances.size(), 0.0);
   for (const auto& [name, value] : j["deposits"].items()) {
     const std::string at = path + ".deposits." + name;
-    const auto it = std::find_if(s.substances.begin(), s.substances.end(),
-                                 [&](const Substance& d) { return d.name == name; });
-    if (it == s.substances.end())
-      throw SceneError(at, "the scene's `substances` declare no substance of this name");
-    if (!it->coating())
+    const std::size_t k = substance_index(s, name, at);
+    if (!s.substances[k].coating())
       throw SceneError(at, "only a coating sticks to a solid: substance '" + name + "' is of kind " +
-                               thaw::name(it->kind));
-    solid.deposits[static_cast<std::size_t>(it - s.substances.begin())] = value["deposit"].get<double>();
+                               thaw::name(s.substances[k].kind));
+    solid.deposits[k] = value["deposit"].get<double>();
   }
   return solid;
 }
@@ -564,13 +562,9 @@ Scene convert_and_check(Json doc, const std::string& folder) {
                          "cleansing needs a cleanser: name the substance in cleansed_by");
       continue;
     }
-    const auto it = std::find_if(s.substances.begin(), s.substances.end(),
-                                 [&](const Substance& d) { return d.name == by; });
-    if (it == s.substances.end() || &*it == &sub)
-      throw SceneError(path, it == s.substances.end()
-                                 ? "the scene's `substances` declare no substance '" + by + "'"
-                                 : "a coating cannot cleanse itself");
-    sub.cleanser = static_cast<int>(it - s.substances.begin());
+    const std::size_t k = substance_index(s, by, path);
+    if (&s.substances[k] == &sub) throw SceneError(path, "a coating cannot cleanse itself");
+    sub.cleanser = static_cast<int>(k);
   }
   s.camera = camera_from_json(doc["camera"]);
 
