@@ -19,6 +19,7 @@
 #include "sim/cl_runtime.h"
 #include "sim/error.h"
 #include "sim/scene.h"
+#include "sim/solver.h"
 #include "sim/state_file.h"
 #include "sim/validation/case.h"
 
@@ -76,6 +77,22 @@ inline std::string read_file_bytes(const fs::path& path) {
 inline std::string state_file_bytes(const SimState& state, const TempDir& dir, const std::string& name) {
   write_state_file(dir / name, state);
   return read_file_bytes(dir / name);
+}
+
+// Steps a run of `scene` from `start` `first` times, saves its state, and steps it `then` more; a run resumed
+// from the saved state to the same step must leave the same state file, byte for byte. `name` names the
+// temporary folder.
+inline bool resumes_bitwise(ClRuntime& cl, const Scene& scene, const SimState& start, int first, int then,
+                            const std::string& name) {
+  TempDir dir(name);
+  Solver straight(cl, scene, start);
+  for (int i = 0; i < first; ++i) straight.step();
+  write_state_file(dir / "half.state", straight.state());
+  for (int i = 0; i < then; ++i) straight.step();
+  const std::string expected = state_file_bytes(straight.state(), dir, "straight.state");
+  Solver resumed(cl, scene, read_state_file(dir / "half.state"));
+  while (resumed.steps() < straight.steps()) resumed.step();
+  return state_file_bytes(resumed.state(), dir, "resumed.state") == expected;
 }
 
 inline void write_text(const fs::path& path, const std::string& text) {

@@ -226,15 +226,7 @@ TEST_F(DepositTest, StainedIceThatMeltsGivesItsDepositToItsWater) {
 
 TEST_F(DepositTest, AResumedRunGoesOnBitwise) {
   const Scene scene = scene_from_json(greasy_plate());
-  TempDir dir("deposit-resume");
-  Solver straight(cl(), scene, initial_state(scene));
-  for (int i = 0; i < 30; ++i) straight.step();
-  write_state_file(dir / "half.state", straight.state());
-  for (int i = 0; i < 20; ++i) straight.step();
-  const std::string expected = testing::state_file_bytes(straight.state(), dir, "straight.state");
-  Solver resumed(cl(), scene, read_state_file(dir / "half.state"));
-  while (resumed.steps() < straight.steps()) resumed.step();
-  EXPECT_TRUE(testing::state_file_bytes(resumed.state(), dir, "resumed.state") == expected);
+  EXPECT_TRUE(testing::resumes_bitwise(cl(), scene, initial_state(scene), 30, 20, "deposit-resume"));
 }
 
 TEST_F(DepositTest, TheExportCarriesTheDeposits) {

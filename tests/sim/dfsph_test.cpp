@@ -67,23 +67,26 @@ TEST_F(DfsphTest, StillWaterHoldsItsDensityAtAFiveTimesLongerStep) {
   int fluid = 0;
   for (std::size_t i = 0; i < p.size(); ++i)
     if (p.phase[i] == static_cast<std::uint8_t>(Phase::Water)) {
-      speed += std::sqrt(double(p.velocity[i][0]) * p.velocity[i][0] + double(p.velocity[i][1]) * p.velocity[i][1] +
+      speed += std::sqrt(double(p.velocity[i][0]) * p.velocity[i][0] +
+                         double(p.velocity[i][1]) * p.velocity[i][1] +
                          double(p.velocity[i][2]) * p.velocity[i][2]);
       ++fluid;
     }
   speed /= fluid;
-  std::printf("[ info ] dt WCSPH %.3g s, DFSPH %.3g s (%.1fx); density solve %d iterations, error %.3g; mean "
-              "density error %.3g, max %.3g; mean iterations %.2f / %.2f; max speed %.3g m/s, mean %.3g sqrt(g H)\n",
-              dt_wcsph, dt_dfsph, dt_dfsph / dt_wcsph, d.dfsph()->last_density().iterations,
-              d.dfsph()->last_density().error, m.mean_density_error, m.max_density_error,
-              double(d.dfsph()->totals().density_iterations) / double(d.dfsph()->totals().steps),
-              double(d.dfsph()->totals().divergence_iterations) / double(d.dfsph()->totals().steps), m.max_speed,
-              speed / std::sqrt(g * H));
+  std::printf(
+      "[ info ] dt WCSPH %.3g s, DFSPH %.3g s (%.1fx); density solve %d iterations, error %.3g; mean "
+      "density error %.3g, max %.3g; mean iterations %.2f / %.2f; max speed %.3g m/s, mean %.3g sqrt(g H)\n",
+      dt_wcsph, dt_dfsph, dt_dfsph / dt_wcsph, d.dfsph()->last_density().iterations,
+      d.dfsph()->last_density().error, m.mean_density_error, m.max_density_error,
+      double(d.dfsph()->totals().density_iterations) / double(d.dfsph()->totals().steps),
+      double(d.dfsph()->totals().divergence_iterations) / double(d.dfsph()->totals().steps), m.max_speed,
+      speed / std::sqrt(g * H));
   EXPECT_GE(dt_dfsph, 5.0 * dt_wcsph);
   EXPECT_TRUE(d.dfsph()->last_density().converged);
   EXPECT_LE(d.dfsph()->last_density().error, df.solver.density_tolerance);
   EXPECT_EQ(d.dfsph()->totals().density_unconverged, 0u);
-  EXPECT_LE(m.mean_density_error, 2 * df.solver.density_tolerance);  // the measured density, not the predicted
+  EXPECT_LE(m.mean_density_error,
+            2 * df.solver.density_tolerance);  // the measured density, not the predicted
   EXPECT_NEAR(m.fluid_mass, mass0, 1e-9 * mass0);
   EXPECT_LT(speed, 0.05 * std::sqrt(g * H));
   EXPECT_EQ(d.clamped(), 0u);
@@ -160,7 +163,8 @@ TEST_F(DfsphTest, ADamBreakRunsInFarFewerStepsWithTheSameFront) {
     const HostParticles p = solver.particles();
     front = 0;
     for (std::size_t i = 0; i < p.size(); ++i)
-      if (p.phase[i] == static_cast<std::uint8_t>(Phase::Water)) front = std::max(front, double(p.position[i][0]));
+      if (p.phase[i] == static_cast<std::uint8_t>(Phase::Water))
+        front = std::max(front, double(p.position[i][0]));
     return solver.steps();
   };
   double wc_front = 0, df_front = 0;
@@ -262,9 +266,10 @@ TEST_F(DfsphTest, ATapFillsATankWithEveryParticleAccountedFor) {
   for (int i = 0; i < 20; ++i) d.step();
   const Metrics m = measure(d);
   const InflowBooks in = d.inflow();
-  std::printf("[ info ] poured %llu particles (%.4g kg) in %llu steps; capacity %zu -> %zu; density error %.3g\n",
-              (unsigned long long)in.particles, in.mass, (unsigned long long)d.steps(), capacity0, d.capacity(),
-              d.dfsph()->last_density().error);
+  std::printf(
+      "[ info ] poured %llu particles (%.4g kg) in %llu steps; capacity %zu -> %zu; density error %.3g\n",
+      (unsigned long long)in.particles, in.mass, (unsigned long long)d.steps(), capacity0, d.capacity(),
+      d.dfsph()->last_density().error);
   EXPECT_GT(d.capacity(), capacity0) << "the tap should have outgrown the first capacity";
   EXPECT_EQ(m.count[static_cast<int>(Phase::Water)], in.particles);
   EXPECT_NEAR(m.fluid_mass, in.mass, 1e-9 * in.mass);
