@@ -108,6 +108,14 @@ float2 add_to_pair(float2 e, float d) {
   return (float2)(hi, lo - (hi - s.x));
 }
 
+/* Moves what `from` holds for particle i into `to`'s pair for it, compensated, and empties `from`'s. */
+void hand_over(global float2* from, global float2* to, const uint i) {
+  const float2 held = from[i];
+  if (held.x == 0.0f && held.y == 0.0f) return;
+  to[i] = add_to_pair(add_to_pair(to[i], held.x), held.y);
+  from[i] = (float2)(0.0f);
+}
+
 /* The lanes of (hi, lo) added in a fixed order, compensated: (sum, its error). */
 float2 lanes_compensated(floatV hi, floatV lo) {
   float s = 0.0f, e = 0.0f;
@@ -138,6 +146,12 @@ float2 lanes_compensated(floatV hi, floatV lo) {
   global const float* M = sub + SUB_M * stride;                             \
   const float4 pi = pos[i];                                                 \
   const int4 cell = grid_cell(g, pi);
+
+/* A walk's compensated lanes (hi, lo) added into particle i's pair in q. */
+void add_lanes(global float2* q, const uint i, floatV hi, floatV lo) {
+  const float2 d = lanes_compensated(hi, lo);
+  q[i] = add_to_pair(add_to_pair(q[i], d.x), d.y);
+}
 
 /* hi, lo += d on every lane, compensated (Knuth's two-sum). */
 #define ACCUMULATE(hi, lo, d)                  \
@@ -208,26 +222,16 @@ kernel void substance_state(global const float4* pos, global const float* densit
   global float2* sa[4] = {s0, s1, s2, s3};
   const float own_area = area[i];
   const int on_surface = water && own_area > P.min_area;
-  for (int s = 0; s < THAW_NSUB; ++s) {
-    if (!((P.surface >> s) & 1u) || on_surface) continue;
-    const float2 held_on = sa[s][i];
-    if (held_on.x == 0.0f && held_on.y == 0.0f) continue;
-    q[s][i] = add_to_pair(add_to_pair(q[s][i], held_on.x), held_on.y);
-    sa[s][i] = (float2)(0.0f);
-  }
+  for (int s = 0; s < THAW_NSUB; ++s)
+    if (((P.surface >> s) & 1u) && !on_surface) hand_over(sa[s], q[s], i);
 #endif
 #ifdef THAW_DEPOSIT
   /* A deposit on ice that has melted goes into the particle's own water (sec. 6.4's deposit stays on the
    * rigid surface it stuck to; that surface is gone). */
   global float2* dep[4] = {d0, d1, d2, d3};
   const int boundary = THAW_IS_STATIC(phase[i]);
-  for (int s = 0; s < THAW_NSUB; ++s) {
-    if (!((P.coating >> s) & 1u) || boundary) continue;
-    const float2 stuck = dep[s][i];
-    if (stuck.x == 0.0f && stuck.y == 0.0f) continue;
-    q[s][i] = add_to_pair(add_to_pair(q[s][i], stuck.x), stuck.y);
-    dep[s][i] = (float2)(0.0f);
-  }
+  for (int s = 0; s < THAW_NSUB; ++s)
+    if (((P.coating >> s) & 1u) && !boundary) hand_over(dep[s], q[s], i);
 #endif
   global const float2* qc[4] = {q0, q1, q2, q3};
   const float2 held = solutes(qc, i, P);
@@ -514,9 +518,11 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
   const float inv_coat_capacity[4] = {P.inv_coat_capacity0, P.inv_coat_capacity1, P.inv_coat_capacity2,
                                       P.inv_coat_capacity3};
   float ri[THAW_NSUB];
+  uint by[THAW_NSUB]; /* each coating's cleanser, 15 for none */
   floatV dhi[THAW_NSUB], dlo[THAW_NSUB];
   for (int s = 0; s < THAW_NSUB; ++s) {
     ri[s] = sub[(SUB_R + s) * stride + i];
+    by[s] = (P.cleanser >> (4 * s)) & 15u;
     dhi[s] = (floatV)(0.0f);
     dlo[s] = (floatV)(0.0f);
   }
@@ -536,8 +542,7 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
           const floatV wgt = select((floatV)(0.0f), mi * w_shape(qr), wet_j);
           for (int s = 0; s < THAW_NSUB; ++s) {
             if (!((P.coating >> s) & 1u)) continue;
-            const uint by = (P.cleanser >> (4 * s)) & 15u;
-            const float wd = by < THAW_NSUB ? wi[by] : 0.0f;
+            const float wd = by[s] < THAW_NSUB ? wi[by[s]] : 0.0f;
             const floatV g_j = vloadV(0, sub + (SUB_R + s) * stride + j);
             const floatV given = -DEPOSITED(f_j, wgt, wi[s], wd, g_j, s);
             ACCUMULATE(hi[s], lo[s], given)
@@ -551,9 +556,8 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
           const floatV wgt = select((floatV)(0.0f), mj * w_shape(qr), carrier);
           for (int s = 0; s < THAW_NSUB; ++s) {
             if (!((P.coating >> s) & 1u)) continue;
-            const uint by = (P.cleanser >> (4 * s)) & 15u;
             const floatV wc = vloadV(0, sub + (SUB_W + s) * stride + j);
-            const floatV wd = by < THAW_NSUB ? vloadV(0, sub + (SUB_W + by) * stride + j) : (floatV)(0.0f);
+            const floatV wd = by[s] < THAW_NSUB ? vloadV(0, sub + (SUB_W + by[s]) * stride + j) : (floatV)(0.0f);
             const floatV taken = DEPOSITED(f_i, wgt, wc, wd, ri[s], s);
             ACCUMULATE(dhi[s], dlo[s], taken)
           }
@@ -623,27 +627,18 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
   }
   global float2* q[4] = {q0, q1, q2, q3};
   if (mi != 0.0f)
-    for (int s = 0; s < THAW_NSUB; ++s) {
-      const float2 d = lanes_compensated(hi[s], lo[s]);
-      q[s][i] = add_to_pair(add_to_pair(q[s][i], d.x), d.y);
-    }
+    for (int s = 0; s < THAW_NSUB; ++s) add_lanes(q[s], i, hi[s], lo[s]);
 #ifdef THAW_DEPOSIT
   global float2* dep[4] = {d0, d1, d2, d3};
   if (f_i > 0.0f)
-    for (int s = 0; s < THAW_NSUB; ++s) {
-      if (!((P.coating >> s) & 1u)) continue;
-      const float2 d = lanes_compensated(dhi[s], dlo[s]);
-      dep[s][i] = add_to_pair(add_to_pair(dep[s][i], d.x), d.y);
-    }
+    for (int s = 0; s < THAW_NSUB; ++s)
+      if ((P.coating >> s) & 1u) add_lanes(dep[s], i, dhi[s], dlo[s]);
 #endif
 #ifdef THAW_SURFACE
   global float2* sa[4] = {s0, s1, s2, s3};
   if (area_i > 0.0f)
-    for (int s = 0; s < THAW_NSUB; ++s) {
-      if (!((P.surface >> s) & 1u)) continue;
-      const float2 d = lanes_compensated(shi[s], slo[s]);
-      sa[s][i] = add_to_pair(add_to_pair(sa[s][i], d.x), d.y);
-    }
+    for (int s = 0; s < THAW_NSUB; ++s)
+      if ((P.surface >> s) & 1u) add_lanes(sa[s], i, shi[s], slo[s]);
 #endif
 #ifdef THAW_TENSION_LAW
   /* Each water particle's surface tension over the scene's, from the surface excess it now holds: each

@@ -79,12 +79,16 @@ kernel void tension_columns(global const uchar* phase, global const uchar* mater
 }
 
 /* A neighbour pass's start: particle i's position and cell, the support and the candidates' x, y, z. */
-#define TENSION_START                        \
+#define TENSION_START     \
+  const float4 pi = pos[i]; \
+  TENSION_WALK(pi)
+
+/* The same with pi already in scope: the support, pi's cell and the candidates' x, y, z. */
+#define TENSION_WALK(pi)                                    \
   const float H = P.support, H2 = H * H, inv_H = 1.0f / H; \
-  const float4 pi = pos[i];                  \
-  const int4 c = grid_cell(g, pi);           \
-  global const float* X = soa;               \
-  global const float* Y = soa + stride;      \
+  const int4 c = grid_cell(g, pi);                          \
+  global const float* X = soa;                              \
+  global const float* Y = soa + stride;                     \
   global const float* Z = soa + 2 * stride;
 
 /* sum_j V_j grad_shape(r / H) (x_i - x_j) over the neighbours within H, on lanes: the colour gradient
@@ -440,11 +444,7 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
    * eq. 30). The gradient is fitted by weighted least squares to sigma_j - sigma_i over the outer layer's
    * particles in the support, on the tangent plane of n_i, so a linear sigma gives its slope exactly. */
   if (area_i > 0.0f) {
-    const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
-    const int4 c = grid_cell(g, pi);
-    global const float* X = soa;
-    global const float* Y = soa + stride;
-    global const float* Z = soa + 2 * stride;
+    TENSION_WALK(pi)
     global const float* A = col + COL_A * stride;
     global const float* S = col + COL_S * stride;
     const float3 e = fabs(n.x) < 0.6f ? (float3)(1.0f, 0.0f, 0.0f) : (float3)(0.0f, 1.0f, 0.0f);
@@ -480,11 +480,7 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
 #endif
 #ifdef THAW_TENSION_ADHESION
   {
-    const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
-    const int4 c = grid_cell(g, pi);
-    global const float* X = soa;
-    global const float* Y = soa + stride;
-    global const float* Z = soa + 2 * stride;
+    TENSION_WALK(pi)
     global const float* B = col + COL_B * stride;
     const float adhesion = 0.007f / (H * H * H);
     floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
