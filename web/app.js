@@ -419,10 +419,13 @@ function aimAt(e) {
 // how much sits on the water's surface (a detergent) and on solids and ice (a coating), where it can.
 function showSubstance() {
   const b = substanceBooks[$('substance').value];
-  const grams = (kg) => (1e3 * kg).toPrecision(3);
-  let text = b ? `${grams(b.total)} g held, ${grams(b.inflow)} g added` : '';
-  if (b && b.on_surface > 0) text += `; ${grams(b.on_surface)} g on the surface`;
-  if (b && b.on_solids > 0) text += `; ${grams(b.on_solids)} g on solids and ice`;
+  // In g, mg or µg, whichever reads without an exponent.
+  const mass = (kg) => kg >= 1e-3 ? `${(1e3 * kg).toPrecision(3)} g` : kg >= 1e-6 ? `${(1e6 * kg).toPrecision(3)} mg`
+                                                                  : `${(1e9 * kg).toPrecision(3)} µg`;
+  let text = b ? `${mass(b.total)} held` : '';
+  if (b && b.inflow > 0) text += `, ${mass(b.inflow)} added`;
+  if (b && b.on_surface > 0) text += `; ${mass(b.on_surface)} on the surface`;
+  if (b && b.on_solids > 0) text += `; ${mass(b.on_solids)} on solids and ice`;
   $('substance-total').textContent = text;
 }
 $('substance').addEventListener('change', showSubstance);

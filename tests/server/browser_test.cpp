@@ -206,16 +206,21 @@ async def scenario(call, js, until):
     print("panel", await until("!document.getElementById('substances').hidden && substances.length === 2", 30))
     print("books", bool(await until("substanceBooks.grease && substanceBooks.grease.on_solids > 0", 30)))
     await js("{ const s = document.getElementById('substance'); s.value = 'grease'; s.dispatchEvent(new Event('change')); }")
-    print("on solids", bool(await until(f"/g on solids and ice/.test({TOTAL})", 20)))
+    print("on solids", bool(await until(f"/[0-9.]+ (g|mg|µg) on solids and ice/.test({TOTAL}) && !/e-/.test({TOTAL})", 20)))
     print("[ info ] " + await js(TOTAL))
     await js("{ const s = document.getElementById('substance'); s.value = 'detergent'; s.dispatchEvent(new Event('change')); }")
-    print("on surface", bool(await until(f"/g on the surface/.test({TOTAL}) && !/on solids/.test({TOTAL})", 20)))
+    print("on surface", bool(await until(f"/[0-9.]+ (g|mg|µg) on the surface/.test({TOTAL}) && !/on solids/.test({TOTAL}) && !/e-/.test({TOTAL})", 20)))
     print("[ info ] " + await js(TOTAL))
 )py"),
                                             240, &status);
   EXPECT_EQ(status, 0) << out;
   expect_lines(out, {"connected True", "panel True", "books True", "on solids True", "on surface True",
                      "screenshot True"});
+  // THAW_TEST_SCREENSHOTS=DIR keeps the page.
+  if (const char* keep = std::getenv("THAW_TEST_SCREENSHOTS"))
+    std::filesystem::copy_file(dir.path() / "browser.png",
+                               std::filesystem::path(keep) / "browser-coating.png",
+                               std::filesystem::copy_options::overwrite_existing);
   for (std::size_t at = out.find("[ info ]"); at != std::string::npos; at = out.find("[ info ]", at + 1))
     std::printf("%s\n", out.substr(at, out.find('\n', at) - at).c_str());
   EXPECT_TRUE(served.stop()) << served.log();
