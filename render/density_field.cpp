@@ -172,6 +172,48 @@ void blur(std::vector<float>& field, const FieldGrid& g, const IndexBox& d, cons
   }
 }
 
+// The tint's per-particle weights (build_density_fields). The dye's: each water particle's concentration of
+// the tint substance over the reference (the given one, else the most any water particle holds); none when no
+// water holds any. The stain's, for a coating: each ice and solid particle's deposit over the coating's
+// capacity (unlimited: the most any holds); none when nothing holds any. An unknown substance is an Error.
+template <class SlotAt>
+void tint_weights(const RenderSnapshot& s, const FieldOptions& o, const SlotAt& slot_at, DensityFields& f,
+                  std::vector<float>& dye, std::vector<float>& stain) {
+  std::size_t index = s.substances.size();
+  for (std::size_t i = 0; i < s.substances.size(); ++i)
+    if (s.substances[i].first == o.tint) index = i;
+  if (index == s.substances.size() || s.substances[index].second.size() != s.position.size())
+    throw Error("density field: the snapshot holds no substance '" + o.tint + "' to tint by");
+  if (index < s.substance_colours.size()) f.tint_colour = s.substance_colours[index];
+  const std::vector<float>& c = s.substances[index].second;
+  float reference = o.tint_reference;
+  if (!(reference > 0))
+    for (std::size_t p = 0; p < c.size(); ++p)
+      if (slot_at(p) == kWater && std::isfinite(c[p])) reference = std::max(reference, c[p]);
+  if (reference > 0) {
+    f.tint_reference = reference;
+    dye.assign(c.size(), 0.0f);
+    for (std::size_t p = 0; p < c.size(); ++p)
+      if (slot_at(p) == kWater && std::isfinite(c[p])) dye[p] = std::max(c[p], 0.0f) / reference;
+  }
+  for (std::size_t k = 0; k < s.deposits.size(); ++k) {
+    const auto& [name, deposit] = s.deposits[k];
+    if (name != o.tint || deposit.size() != s.position.size()) continue;
+    float full = k < s.deposit_capacity.size() ? s.deposit_capacity[k] : 0.0f;
+    if (!(full > 0))
+      for (float v : deposit) full = std::max(full, std::isfinite(v) ? v : 0.0f);
+    bool any = false;
+    for (float v : deposit) any = any || v > 0;
+    if (!any || !(full > 0)) break;
+    stain.assign(deposit.size(), 0.0f);
+    for (std::size_t p = 0; p < deposit.size(); ++p) {
+      const int slot = slot_at(p);
+      if ((slot == kIce || slot == kSolid) && std::isfinite(deposit[p]))
+        stain[p] = std::clamp(deposit[p] / full, 0.0f, 1.0f);
+    }
+  }
+}
+
 }  // namespace
 
 DensityFields build_density_fields(const RenderSnapshot& s, const FieldOptions& options) {
@@ -209,6 +251,11 @@ DensityFields build_density_fields(const RenderSnapshot& s, const FieldOptions& 
     f.water = f.solid = f.ice;
     return f;
   }
+
+  // The tint's weights per particle: concentration over the reference in water, deposit over the capacity on
+  // solids and ice (the glass left clear).
+  std::vector<float> dye_weight, stain_weight;
+  if (!options.tint.empty()) tint_weights(s, options, slot_at, f, dye_weight, stain_weight);
 
   const Layout layout = lay_out(lo, hi, s.spacing, options.max_cells);
   const FieldGrid& g = f.grid = layout.grid;
@@ -251,28 +298,49 @@ DensityFields build_density_fields(const RenderSnapshot& s, const FieldOptions& 
   // waits a scheduler time slice at each one when the other core is busy (measured: 5x slower than one
   // thread), while independent tasks meet once. Each field is computed by one thread in one order, so
   // the result does not depend on the thread count.
+  // Tasks 0-3 are the phases; 4 the dye, deposited by the water's particles; 5 the stain, by the ice's and
+  // solids'. Each weights its particles' volume by its own weights (none: 1).
+  struct Task {
+    std::vector<float>* field;
+    std::vector<int> slots;
+    const std::vector<float>* weight;
+  };
+  const std::array<Task, kSlots + 2> tasks = {{{&f.ice, {kIce}, nullptr},
+                                               {&f.water, {kWater}, nullptr},
+                                               {&f.solid, {kSolid}, nullptr},
+                                               {&f.glass, {kGlass}, nullptr},
+                                               {&f.dye, {kWater}, &dye_weight},
+                                               {&f.stain, {kIce, kSolid}, &stain_weight}}};
   const std::vector<float> w = gaussian_weights(layout.sigma_cells);
-  std::array<std::vector<float>*, kSlots> fields{&f.ice, &f.water, &f.solid, &f.glass};
   const std::size_t dy = std::size_t(g.nx), dz = std::size_t(g.nx) * g.ny;
 #pragma omp parallel for schedule(dynamic, 1)
-  for (int slot = 0; slot < kSlots; ++slot) {
-    std::vector<float>& field = *fields[slot];
-    if (slot == kGlass && s.glass.empty()) continue;  // no glass: no field
+  for (int t = 0; t < int(tasks.size()); ++t) {
+    const Task& task = tasks[std::size_t(t)];
+    std::vector<float>& field = *task.field;
+    if (t == kGlass && s.glass.empty()) continue;       // no glass: no field
+    if (task.weight && task.weight->empty()) continue;  // no tint
     field.assign(g.size(), 0.0f);
-    for (std::size_t q = start[std::size_t(slot) * g.nz]; q < start[std::size_t(slot + 1) * g.nz]; ++q) {
-      const Deposit& dep = deposits[order[q]];
-      const float wx[2] = {1 - dep.frac.x(), dep.frac.x()}, wy[2] = {1 - dep.frac.y(), dep.frac.y()};
-      const float wz[2] = {1 - dep.frac.z(), dep.frac.z()};
-      for (int k = 0; k < 2; ++k) {
-        for (int j = 0; j < 2; ++j) {
-          float* v = field.data() + dep.node + k * dz + j * dy;
-          const float wjk = volume * wy[j] * wz[k];
-          v[0] += wx[0] * wjk;
-          v[1] += wx[1] * wjk;
+    IndexBox bounds;
+    for (const int slot : task.slots) {
+      bounds.lo = bounds.lo.cwiseMin(box[slot].lo);
+      bounds.hi = bounds.hi.cwiseMax(box[slot].hi);
+      for (std::size_t q = start[std::size_t(slot) * g.nz]; q < start[std::size_t(slot + 1) * g.nz]; ++q) {
+        const Deposit& dep = deposits[order[q]];
+        const float amount = task.weight ? volume * (*task.weight)[order[q]] : volume;
+        if (amount == 0.0f) continue;
+        const float wx[2] = {1 - dep.frac.x(), dep.frac.x()}, wy[2] = {1 - dep.frac.y(), dep.frac.y()};
+        const float wz[2] = {1 - dep.frac.z(), dep.frac.z()};
+        for (int k = 0; k < 2; ++k) {
+          for (int j = 0; j < 2; ++j) {
+            float* v = field.data() + dep.node + k * dz + j * dy;
+            const float wjk = amount * wy[j] * wz[k];
+            v[0] += wx[0] * wjk;
+            v[1] += wx[1] * wjk;
+          }
         }
       }
     }
-    blur(field, g, box[slot], w);
+    blur(field, g, bounds, w);
   }
   return f;
 }

@@ -52,6 +52,7 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
       }
     }
     s.substances.push_back({sub.name, std::move(c)});
+    s.substance_colours.push_back(sub.colour);
     if (!sub.coating()) continue;
     std::vector<float> d(p.size(), 0.0f);
     const HostColumn* col = p.column(deposited_field(sub.name).name);
@@ -62,6 +63,7 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
         d[i] = static_cast<float>((double(q[0]) + double(q[1])) / face);
       }
     s.deposits.push_back({sub.name, std::move(d)});
+    s.deposit_capacity.push_back(static_cast<float>(sub.coating_capacity));
   }
   for (const Dryer& d : scene.dryers)
     s.dryers.push_back({d.position.cast<float>(), d.direction.normalized().cast<float>(),

@@ -2,6 +2,7 @@
 // What the renderer draws: a read-only copy of the particles taken between simulation steps, so that
 // rendering never touches the simulation's buffers (docs/ARCHITECTURE.md: render reads a snapshot).
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -38,9 +39,12 @@ struct RenderSnapshot {
   // Each substance the scene declares, by name: its concentration in each particle [kg/m^3 = g/L], bulk and
   // surface amounts over the particle's volume at its material's rest density (0 where it holds none).
   std::vector<std::pair<std::string, std::vector<float>>> substances;
+  std::vector<std::array<float, 3>>
+      substance_colours;  // each one's colour (Substance::colour), in that order
   // Each coating the scene declares, by name: what sticks to each solid or ice particle per area of its face
   // [kg/m^2] (0 elsewhere).
   std::vector<std::pair<std::string, std::vector<float>>> deposits;
+  std::vector<float> deposit_capacity;  // each coating's Gamma_R,max [kg/m^2] in that order; 0: no limit
   // The scene's dryers as they are at this step, then its taps (emitters): a tap is drawn as a dryer's
   // nozzle that never blows (on = false), its radius the nozzle's.
   std::vector<DryerMarker> dryers;

@@ -77,32 +77,37 @@ void chebyshev_distance(std::vector<std::uint8_t>& d, int nx, int ny, int nz) {
 
 SurfaceRenderer::SurfaceRenderer(EglContext& context) : context_(context) {
   glGenVertexArrays(1, &vao_);
-  program_ = program_for(quality_, false, false);
+  program_ = program_for(quality_, false, false, false);
 }
 
-GLuint SurfaceRenderer::program_for(Quality q, bool glass, bool sources) {
-  GLuint& p = programs_[(q == Quality::Full ? 0 : 1) + (glass ? 2 : 0) + (sources ? 4 : 0)];
+GLuint SurfaceRenderer::program_for(Quality q, bool glass, bool sources, bool tint) {
+  GLuint& p = programs_[(q == Quality::Full ? 0 : 1) + (glass ? 2 : 0) + (sources ? 4 : 0) + (tint ? 8 : 0)];
   if (p) return p;
   // A variant per quality: a uniform switch left the fast frame as slow as the full one on llvmpipe.
   p = build_program("fullscreen.vert", "surface.frag",
                     std::string("#define THAW_SEE_BEHIND ") + (q == Quality::Full ? "1" : "0") +
                         "\n#define THAW_GLASS " + (glass ? "1" : "0") + "\n#define THAW_SOURCES " +
-                        (sources ? "1" : "0") + "\n");
+                        (sources ? "1" : "0") + "\n#define THAW_TINT " + (tint ? "1" : "0") + "\n");
   glUseProgram(p);
   glUniform1i(glGetUniformLocation(p, "u_field"), 0);
   glUniform1i(glGetUniformLocation(p, "u_phases"), 1);
   glUniform1i(glGetUniformLocation(p, "u_blocks"), 2);
+  if (tint) glUniform1i(glGetUniformLocation(p, "u_tint"), 3);
   check_gl("setting up the surface shader");
   return p;
 }
 
+GLuint SurfaceRenderer::current_program() {
+  return program_for(quality_, has_glass_, !dryers_.empty() || !lamps_.empty(), has_tint_);
+}
+
 void SurfaceRenderer::set_quality(Quality q) {
   quality_ = q;
-  program_ = program_for(q, has_glass_, !dryers_.empty() || !lamps_.empty());
+  program_ = current_program();
 }
 
 SurfaceRenderer::~SurfaceRenderer() {
-  for (GLuint t : {field_, phases_, blocks_})
+  for (GLuint t : {field_, phases_, blocks_, tint_})
     if (t) glDeleteTextures(1, &t);
   for (GLuint r : {colour_, marched_colour_})
     if (r) glDeleteRenderbuffers(1, &r);
@@ -120,8 +125,11 @@ void SurfaceRenderer::resize_volume(int nx, int ny, int nz) {
   if (std::max({nx, ny, nz}) > max_size)
     throw Error("surface renderer: a field grid of " + std::to_string(nx) + "x" + std::to_string(ny) + "x" +
                 std::to_string(nz) + " nodes exceeds GL_MAX_3D_TEXTURE_SIZE " + std::to_string(max_size));
-  for (GLuint* t : {&field_, &phases_, &blocks_})
-    if (*t) glDeleteTextures(1, t);
+  for (GLuint* t : {&field_, &phases_, &blocks_, &tint_})
+    if (*t) {
+      glDeleteTextures(1, t);
+      *t = 0;
+    }
   const bool f32 = context_.float_linear();
   const int n[3] = {nx, ny, nz};
   for (int a = 0; a < 3; ++a) {
@@ -143,6 +151,11 @@ void SurfaceRenderer::upload(const DensityFields& f) {
       throw Error("surface renderer: a phase field holds " + std::to_string(v->size()) +
                   " values for a grid of " + std::to_string(g.size()) + " nodes");
   has_glass_ = !f.glass.empty();
+  has_tint_ = !f.dye.empty() || !f.stain.empty();
+  for (const auto* v : {&f.dye, &f.stain})
+    if (!v->empty() && v->size() != g.size())
+      throw Error("surface renderer: a tint field holds " + std::to_string(v->size()) +
+                  " values for a grid of " + std::to_string(g.size()) + " nodes");
   has_volume_ = g.nx >= 2 && g.ny >= 2 && g.nz >= 2 && g.cell > 0 &&
                 !(f.ice.empty() && f.water.empty() && f.solid.empty() && f.glass.empty());
   grid_ = g;
@@ -259,9 +272,31 @@ void SurfaceRenderer::upload(const DensityFields& f) {
                   phase_bytes_.data());
   glBindTexture(GL_TEXTURE_3D, blocks_);
   glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, bx, by, bz, GL_RGBA, GL_FLOAT, block_data_.data());
+  if (has_tint_) upload_tint(f);
   glFinish();
   check_gl("uploading the field textures");
   times_.upload_ms = ms_since(t0);
+}
+
+void SurfaceRenderer::upload_tint(const DensityFields& f) {
+  const FieldGrid& g = f.grid;
+  if (!tint_) tint_ = make_texture_3d(GL_RG16F, g.nx, g.ny, g.nz, GL_LINEAR);
+  tint_data_.resize(2 * g.size());
+  const auto n = static_cast<std::ptrdiff_t>(g.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    tint_data_[2 * i] = f.dye.empty() ? 0.0f : f.dye[i];
+    tint_data_[2 * i + 1] = f.stain.empty() ? 0.0f : f.stain[i];
+  }
+  glBindTexture(GL_TEXTURE_3D, tint_);
+  glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, g.nx, g.ny, g.nz, GL_RG, GL_FLOAT, tint_data_.data());
+  // Beer-Lambert: a thick layer passes the colour, so each channel's absorption is -ln of it, scaled so the
+  // most absorbed channel has kDyeStrength (a white substance: none).
+  const Eigen::Vector3f colour(f.tint_colour[0], f.tint_colour[1], f.tint_colour[2]);
+  const Eigen::Vector3f a = -colour.cwiseMax(0.02f).cwiseMin(1.0f).array().log().matrix();
+  dye_absorption_ =
+      a.maxCoeff() > 0 ? Eigen::Vector3f(a * (kDyeStrength / a.maxCoeff())) : Eigen::Vector3f::Zero();
+  stain_colour_ = colour;
 }
 
 namespace {
@@ -327,7 +362,7 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
   glViewport(0, 0, mw, mh);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
-  program_ = program_for(quality_, has_glass_, !dryers_.empty() || !lamps_.empty());
+  program_ = current_program();
   glUseProgram(program_);
 
   // The camera basis from the view matrix (rows: right, up, -forward), scaled so that
@@ -402,6 +437,12 @@ Image SurfaceRenderer::render(const OrbitCamera& camera) {
   glBindTexture(GL_TEXTURE_3D, phases_);
   glActiveTexture(GL_TEXTURE2);
   glBindTexture(GL_TEXTURE_3D, blocks_);
+  if (has_tint_) {
+    glUniform3fv(loc("u_dye_absorption"), 1, dye_absorption_.data());
+    glUniform3fv(loc("u_stain_colour"), 1, stain_colour_.data());
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_3D, tint_);
+  }
   glBindVertexArray(vao_);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glFinish();

@@ -9,6 +9,8 @@
 //             cheapest on llvmpipe; docs/ARCHITECTURE.md, machine facts).
 //   u_phases  RGBA8: ice, water, solid clamped to [0, 1]; read only at hits and inside ice and water to
 //             tell the phases apart, where 8 bits around iso are plenty.
+//   u_tint    RG16F, only coloured by a substance: the dye and stain fields (DensityFields), read per step
+//             inside water and at hits on solids and ice.
 //   u_blocks  RGBA32F, one texel per block of kBlock^3 cells. R: empty-space skipping, the Chebyshev
 //             distance in blocks to the nearest block that may hold surface (one with a node at or above
 //             iso; trilinear values never exceed their nodes), so a ray jumps out of the whole empty cube
@@ -76,12 +78,16 @@ class SurfaceRenderer {
   static constexpr int kBlock = 4;         // cells per empty-space block along each axis
   static constexpr int kMaxSkip = 16;      // blocks (64 cells): the cap of the distance map
   static constexpr int kShadowSteps = 16;  // blocks toward the light that can shadow a point
+  // The dye's absorption per grid length at its reference concentration, in its most absorbed channel: a
+  // tenth of the grid's length of water at the reference takes about two thirds of that channel.
+  static constexpr float kDyeStrength = 12.0f;
   // Shadow extinction per cell of light path inside ice, water, solid: translucent phases cast pale
   // shadows, solids dark ones.
   static constexpr float kShadowExtinction[4] = {0.06f, 0.02f, 0.45f, 0.03f};  // ice, water, solid, glass
 
  private:
   void upload(const DensityFields& fields);
+  void upload_tint(const DensityFields& fields);  // into tint_, allocated on the volume's first tinted frame
   std::vector<DryerMarker> dryers_;
   std::vector<LampMarker> lamps_;
   void resize_volume(int nx, int ny, int nz);
@@ -90,7 +96,7 @@ class SurfaceRenderer {
 
   EglContext& context_;
   GLuint program_ = 0, vao_ = 0, fbo_ = 0, colour_ = 0;
-  GLuint field_ = 0, phases_ = 0, blocks_ = 0;
+  GLuint field_ = 0, phases_ = 0, blocks_ = 0, tint_ = 0;
   int width_ = 0, height_ = 0;
   // The smaller framebuffer the march draws into when scale_ < 1.
   GLuint marched_fbo_ = 0, marched_colour_ = 0;
@@ -101,15 +107,18 @@ class SurfaceRenderer {
   FieldGrid grid_;
   float iso_ = 0.5f;
   // Staging buffers, kept between frames so a steady stream of uploads does not reallocate.
-  std::vector<float> max_field_, block_data_, extinction_;
+  std::vector<float> max_field_, block_data_, extinction_, tint_data_;
   std::vector<std::uint8_t> phase_bytes_, skip_distance_;
   Times times_;
   Quality quality_ = Quality::Full;
-  // A variant per quality and per what the frame has: glass, dryers or lamps (a glass or dryer branch left in
-  // the shader slowed the march of every frame by a quarter on llvmpipe). Built when first used.
-  GLuint programs_[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-  GLuint program_for(Quality q, bool glass, bool sources);
+  // A variant per quality and per what the frame has: glass, dryers or lamps, a tint (a glass or dryer branch
+  // left in the shader slowed the march of every frame by a quarter on llvmpipe). Built when first used.
+  GLuint programs_[16] = {};
+  GLuint program_for(Quality q, bool glass, bool sources, bool tint);
+  GLuint current_program();
   bool has_glass_ = false;  // the fields uploaded last have glass
+  bool has_tint_ = false;   // ... a dye or a stain
+  Eigen::Vector3f dye_absorption_ = Eigen::Vector3f::Zero(), stain_colour_ = Eigen::Vector3f::Ones();
 };
 
 }  // namespace thaw

@@ -25,7 +25,8 @@ std::vector<T> list_of(const std::string& text, const char* option) {
   while (std::getline(ss, item, ',')) {
     char* end = nullptr;
     const double v = std::strtod(item.c_str(), &end);
-    if (end == item.c_str() || *end != '\0' || v <= 0) throw Error(std::string(option) + ": bad item '" + item + "'");
+    if (end == item.c_str() || *end != '\0' || v <= 0)
+      throw Error(std::string(option) + ": bad item '" + item + "'");
     out.push_back(static_cast<T>(v));
   }
   if (out.empty()) throw Error(std::string(option) + ": empty list");
@@ -57,7 +58,8 @@ int cmd_bench(int argc, char** argv) {
   }
   if (kind == "accuracy") {
     CliArgs args(argc, argv, 3, {"--res", "--out", "--device"}, {"--json"});
-    if (args.positional().size() != 1) throw Error("bench accuracy needs one CASE (see thaw validate --list)");
+    if (args.positional().size() != 1)
+      throw Error("bench accuracy needs one CASE (see thaw validate --list)");
     AccuracyOptions o;
     o.case_name = args.positional()[0];
     if (auto r = args.value("--res")) o.resolutions = list_of<int>(*r, "--res");
@@ -70,8 +72,9 @@ int cmd_bench(int argc, char** argv) {
   }
   if (kind == "render") {
     CliArgs args(argc, argv, 3, {"--sizes", "--frames", "--field-cells", "--quality", "--scales"},
-                 {"--json"});
+                 {"--json", "--tint"});
     RenderBenchOptions o;
+    o.tint = args.flag("--tint");
     if (auto s = args.value("--scales")) o.scales = list_of<double>(*s, "--scales");
     for (const double s : o.scales)
       if (!(s >= SurfaceRenderer::kMinScale && s <= 1.0)) throw Error("--scales: each must be 0.25..1");
@@ -81,7 +84,8 @@ int cmd_bench(int argc, char** argv) {
     o.field_cells = static_cast<int>(args.integer("--field-cells", o.field_cells));
     if (o.field_cells < 16 || o.field_cells > 512) throw Error("--field-cells: expected 16..512");
     const std::string quality = args.value("--quality").value_or("full");
-    if (quality != "full" && quality != "fast") throw Error("--quality: expected full or fast, got '" + quality + "'");
+    if (quality != "full" && quality != "fast")
+      throw Error("--quality: expected full or fast, got '" + quality + "'");
     o.fast = quality == "fast";
     const Json r = bench_render(o, !args.flag("--json"));
     if (args.flag("--json")) std::printf("%s\n", r.dump(2).c_str());

@@ -32,14 +32,15 @@ constexpr CommandHelp kCommands[] = {
      "  bench throughput µs per particle-step per stage, with a hand-written reference loop (--json)\n"
      "  bench accuracy CASE  error against run time over resolutions (--res 10,15,20 --out DIR)\n"
      "  bench render     ms per frame by stage (field, upload, march, read-back, JPEG) (--sizes, --quality,\n"
-     "                   --scales 1,0.75,0.5, --json)\n"
+     "                   --scales 1,0.75,0.5, --tint: also coloured by a dye, --json)\n"
      "  bench bodies     ice labelling and per-body sums against union-find and a plain loop (--size, "
      "--json)\n"},
     {"render",
      "  render STATE     one frame of a state file: --out FILE.png, --view surface|particles|slice,\n"
      "                   --size WxH, --camera AZ,EL[,DIST], --target X,Y,Z, --fov DEG, --colour-by\n"
      "                   phase|temperature|speed|substance:NAME, --slice AXIS[,FRACTION], --field-cells N,\n"
-     "                   --quality full|fast, --pick X,Y\n"},
+     "                   --quality full|fast, --tint-reference G/L (surface by a substance: the\n"
+     "                   concentration of full colour; default the first frame's most), --pick X,Y\n"},
     {"info",
      "  info             OpenCL platforms and devices, and the one that would be used; the renderer\n"},
     {"scene-doc", "  scene-doc        the scene file reference (docs/SCENES.md)\n"},

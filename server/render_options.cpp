@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <vector>
 
@@ -109,12 +110,40 @@ RenderOptions render_options(const CliArgs& args, const SceneCamera& camera) {
     o.fov = args.number("--fov", 40.0);
     if (!(o.fov >= 5.0 && o.fov <= 120.0)) throw Error("--fov: expected 5..120 degrees, got '" + *v + "'");
   }
+  if (auto v = args.value("--tint-reference")) {
+    const double c = args.number("--tint-reference", 0.0);
+    if (!(c > 0 && c <= 1e4))
+      throw Error("--tint-reference: expected a concentration in (0, 1e4] g/L, got '" + *v + "'");
+    o.field.tint_reference = static_cast<float>(c);
+  }
   if (auto v = args.value("--field-cells")) {
     const long long cells = args.integer("--field-cells", 128);
     if (cells < 16 || cells > 512) throw Error("--field-cells: expected 16..512, got '" + *v + "'");
     o.field.max_cells = static_cast<int>(cells);
   }
   return o;
+}
+
+FieldOptions surface_fields(const RenderOptions& o) {
+  FieldOptions f = o.field;
+  const std::size_t n = std::strlen(kSubstanceColouring);
+  f.tint = o.colour_by.rfind(kSubstanceColouring, 0) == 0 ? o.colour_by.substr(n) : std::string();
+  if (f.tint.empty()) f.tint_reference = 0;
+  return f;
+}
+
+FieldOptions TintLatch::apply(FieldOptions fields, double time) const {
+  if (!fields.tint.empty() && fields.tint_reference == 0 && fields.tint == substance_ && time >= time_)
+    fields.tint_reference = reference_;
+  return fields;
+}
+
+void TintLatch::remember(const FieldOptions& fields, const DensityFields& built, double time) {
+  if (fields.tint.empty() || !(built.tint_reference > 0)) return;
+  if (fields.tint == substance_ && reference_ > 0 && time >= time_) return;
+  substance_ = fields.tint;
+  reference_ = built.tint_reference;
+  time_ = time;
 }
 
 OrbitCamera camera_for(const RenderOptions& o, const RenderSnapshot& s) {
@@ -170,7 +199,9 @@ Image FrameRenderer::render(const RenderSnapshot& s) {
   };
   times_ = {};
   if (surface_) {
-    const DensityFields fields = build_density_fields(s, options_.field);
+    const FieldOptions wanted = tint_.apply(surface_fields(options_), s.time);
+    const DensityFields fields = build_density_fields(s, wanted);
+    tint_.remember(wanted, fields, s.time);
     times_.field_ms = since(t0);
     surface_->set_sources(s.dryers, s.lamps);
     Image image = surface_->render(fields, camera_for(options_, s));

@@ -153,19 +153,22 @@ bool RenderWorker::render_one(const std::shared_ptr<const RenderSnapshot>& snaps
                                                          : SurfaceRenderer::Quality::Full);
       gl_->surface.set_sources(snapshot->dryers, snapshot->lamps);
       gl_->surface.set_scale(options.scale);
-      const bool same = gl_->fields && uploaded_ == snapshot &&
-                        uploaded_field_options_.max_cells == options.field.max_cells &&
-                        uploaded_field_options_.iso == options.field.iso;
+      const FieldOptions wanted = tint_.apply(surface_fields(options), snapshot->time);
+      const bool same = gl_->fields && uploaded_ == snapshot && uploaded_field_options_ == wanted;
       if (same) {
         // Only the camera moved (e.g. orbiting a paused scene): draw the uploaded fields again.
         fields = gl_->fields;
         image = gl_->surface.render(camera);
       } else {
-        fields = std::make_shared<const DensityFields>(build_density_fields(*snapshot, options.field));
+        fields = std::make_shared<const DensityFields>(build_density_fields(*snapshot, wanted));
         image = gl_->surface.render(*fields, camera);
         gl_->fields = fields;
         uploaded_ = snapshot;
-        uploaded_field_options_ = options.field;
+        uploaded_field_options_ = wanted;
+        tint_.remember(wanted, *fields, snapshot->time);
+        // The next frame of this snapshot asks for the latched reference: the same fields.
+        if (!wanted.tint.empty() && wanted.tint_reference == 0)
+          uploaded_field_options_.tint_reference = fields->tint_reference;
       }
       renderer = gl_->context.description();
     } else {

@@ -1,7 +1,7 @@
 #pragma once
-// The render thread of `thaw serve` (docs/ARCHITECTURE.md, Server): it owns the EGL context (created on this thread,
-// the only one that may use it), renders the session's newest snapshot in the current view, encodes it
-// to JPEG once for every viewer and publishes the newest frame; the network loop takes it from there.
+// The render thread of `thaw serve` (docs/ARCHITECTURE.md, Server): it owns the EGL context (created on this
+// thread, the only one that may use it), renders the session's newest snapshot in the current view, encodes
+// it to JPEG once for every viewer and publishes the newest frame; the network loop takes it from there.
 // Frames are never queued: a snapshot that arrives while a frame is being rendered replaces any older
 // one waiting, so the worker always draws the latest state and falls behind by at most one frame.
 //
@@ -155,6 +155,7 @@ class RenderWorker {
   bool gl_failed_ = false;
   std::shared_ptr<const RenderSnapshot> uploaded_;
   FieldOptions uploaded_field_options_;
+  TintLatch tint_;  // the render thread's
   std::uint64_t frames_ = 0;
 };
 

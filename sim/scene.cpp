@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -107,6 +108,21 @@ E choice_of(const Json& value, std::initializer_list<E> options) {
 }  // namespace
 
 namespace {
+
+// A substance's colour from "#rrggbb"; empty: the index-th of red, blue, green and amber, so the scene's
+// substances differ without being told.
+std::array<float, 3> substance_colour(const std::string& text, std::size_t index, const std::string& path) {
+  static constexpr std::array<std::array<float, 3>, 4> kPalette = {
+      {{0.78f, 0.08f, 0.30f}, {0.10f, 0.30f, 0.85f}, {0.10f, 0.62f, 0.22f}, {0.85f, 0.55f, 0.10f}}};
+  if (text.empty()) return kPalette[index % kPalette.size()];
+  const bool hex = text.size() == 7 && text[0] == '#' &&
+                   std::all_of(text.begin() + 1, text.end(), [](char c) { return std::isxdigit(c) != 0; });
+  if (!hex) throw SceneError(path, "expected a colour as #rrggbb, e.g. #c8144c, got '" + text + "'");
+  std::array<float, 3> rgb{};
+  for (std::size_t c = 0; c < 3; ++c)
+    rgb[c] = float(std::stoi(text.substr(1 + 2 * c, 2), nullptr, 16)) / 255.0f;
+  return rgb;
+}
 
 // A sanity limit: beyond this a typo in `spacing` would exhaust memory before any error appears.
 constexpr double kMaxParticles = 20e6;
@@ -530,6 +546,8 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     sub.enters_ice = d["enters_ice"].get<bool>();
     sub.kind = choice_of<SubstanceKind>(
         d["kind"], {SubstanceKind::Bulk, SubstanceKind::SurfaceActive, SubstanceKind::Coating});
+    sub.colour = substance_colour(d["colour"].get<std::string>(), s.substances.size(),
+                                  "substances." + name + ".colour");
     if (sub.surface_active()) {
       sub.surface_diffusivity = d["surface_diffusivity"].get<double>();
       sub.adsorption_rate = d["adsorption_rate"].get<double>();

@@ -158,6 +158,9 @@ struct Substance {
   int cleanser = -1;               // index of the substance that cleanses it; -1: none
   double cleansing_rate = 0.0;     // k_r [m^3/(kg s)]
   bool coating() const { return kind == SubstanceKind::Coating; }
+  // The colour a thick layer of it gives white light (sRGB, each in [0, 1]): how the surface view tints water
+  // that holds it and solids and ice a coating of it stains.
+  std::array<float, 3> colour = {0.78f, 0.08f, 0.30f};
 };
 inline constexpr int kMaxSubstances = 4;  // per scene: the stage walks the neighbours once for all of them
 

@@ -460,6 +460,12 @@ const Field& scene_schema() {
                        "Whether water that freezes keeps it; false (salt, dye): the freezing water gives "
                        "it up to the water around it")
                       .def(false),
+                  text("colour",
+                       "The colour it gives the water in the surface view coloured by it (and a coating's "
+                       "stain on solids and ice), as #rrggbb: what white light looks like through a thick "
+                       "layer of it. Empty: red, blue, green or amber by its place among the scene's "
+                       "substances")
+                      .def(""),
                   choice("kind", {"bulk", "surface_active", "coating"},
                          "bulk: it stays dissolved in the water; surface_active (a detergent): it also "
                          "gathers on the water's free surface, adsorbing from and desorbing to the water "

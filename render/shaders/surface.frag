@@ -13,6 +13,9 @@
 //          passing on through the wall, tinted by Beer-Lambert along the path inside it: the ray goes on
 //          to what the glass holds, through up to kGlassLayers walls.
 // Translucent phases show what lies behind them along the straight ray (no refraction), shaded opaque.
+// Coloured by a substance (THAW_TINT): the water holding it absorbs by Beer-Lambert in proportion to the
+// concentration along the path, so it takes the substance's colour, deeper where there is more of it; a
+// coating stains the solids and ice it sticks to toward that colour.
 // Dryers are drawn over the scene: a dark nozzle, and while one blows a faint warm cone of its reach,
 // hidden behind the first opaque surface, so aiming shows. Lamps are their emitting rectangles, glowing
 // on their emitting side while on.
@@ -29,6 +32,9 @@ precision highp sampler3D;
 uniform sampler3D u_field;   // max of the phases, linear
 uniform sampler3D u_phases;  // ice, water, solid, glass in [0, 1], linear
 uniform sampler3D u_blocks;  // per block: skip distance, fraction inside, light transmittance
+uniform sampler3D u_tint;    // THAW_TINT: dye (concentration / reference in water), stain (deposit / capacity)
+uniform vec3 u_dye_absorption;  // per grid length, at the reference concentration
+uniform vec3 u_stain_colour;
 uniform int u_has_volume;
 uniform vec3 u_nodes;        // nodes per axis
 uniform vec3 u_block_count;  // blocks per axis
@@ -63,6 +69,9 @@ out vec4 o_colour;
 #ifndef THAW_SOURCES
 #define THAW_SOURCES 1  // 1: dryers and lamps are drawn
 #endif
+#ifndef THAW_TINT
+#define THAW_TINT 0  // 1: the water is dyed and the solids stained by the u_tint texture
+#endif
 const int kMaxSteps = 1024;    // march iterations (jumps and steps)
 const int kBisections = 5;     // 1/32 cell
 const int kMaxInside = 128;    // steps through ice or water
@@ -93,6 +102,18 @@ const int kMaxGlass = 48;     // cells through one glass wall
 vec3 tex_coord(vec3 g) { return (g + 0.5) / u_nodes; }
 float field(vec3 g) { return texture(u_field, tex_coord(g)).r; }
 vec4 phases(vec3 g) { return texture(u_phases, tex_coord(g)); }
+#if THAW_TINT
+float dye(vec3 g) { return texture(u_tint, tex_coord(g)).r; }
+// How stained a solid or ice surface is at g, where its own field reads `own`: the stain field is the deposit
+// share times the volume fraction, so the ratio is the share.
+vec3 stained(vec3 base, vec3 g, float own) {
+  float share = clamp(texture(u_tint, tex_coord(g)).g / max(own, 0.25), 0.0, 1.0);
+  return mix(base, u_stain_colour * 0.9, 0.85 * share);
+}
+#else
+float dye(vec3 g) { return 0.0; }
+vec3 stained(vec3 base, vec3 g, float own) { return base; }
+#endif
 // Block b's texel centre lies at the centre of its cells, (b + 0.5) * u_block.
 vec4 coarse(vec3 g) { return texture(u_blocks, g / (u_block * u_block_count)); }
 
@@ -201,12 +222,13 @@ vec3 normal_at(vec3 p, vec3 d, vec3 inv, vec2 span, float t) {
 // The colour of an opaque solid, ice or water (phase 0, 1, 2) hit at t with normal n.
 vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
   float ao = occlusion(p, n), sh = shadow(p, n);
-  if (phase == 2) return diffuse(kSolidColour, n, ao, sh);
+  if (phase == 2) return diffuse(stained(kSolidColour, p, phases(p).b), n, ao, sh);
 
   // Walk through ice and water to their far side, or to a solid inside them, summing the path in each.
   // One RGBA8 fetch per step tells the phases apart. The exit is then refined by bisection (after the
   // loop, as in first_hit): a path quantised to whole steps shows as contour bands.
   float path_ice = 0.0, path_water = 0.0, w = phase == 0 ? 1.0 : 0.0;  // w: the ice share of the medium
+  float path_dye = 0.0;  // the dye's concentration over its reference, integrated along the path
   float water_in_front = -1.0;  // the water path before the ray first meets ice inside the medium
   float tb = t, tn = t;
   bool left = false;
@@ -221,6 +243,7 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
     if (water_in_front < 0.0 && w > 0.5) water_in_front = path_water;
     path_ice += (tn - tb) * w;
     path_water += (tn - tb) * (1.0 - w);
+    if (THAW_TINT == 1) path_dye += (tn - tb) * dye(u_eye + tn * d);
     tb = tn;
   }
   bool solid_behind = false;
@@ -236,6 +259,7 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
     }
     path_ice += (tn - tb) * w;
     path_water += (tn - tb) * (1.0 - w);
+    if (THAW_TINT == 1) path_dye += (tn - tb) * dye(u_eye + 0.5 * (tb + tn) * d);
     // Where a medium meets a solid both fields sit near iso at the exit: look a cell further.
     solid_behind = phases(u_eye + (tn + 1.0) * d).b >= u_iso;
     tb = tn;
@@ -249,7 +273,7 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
     const vec2 e = vec2(1.0, -1.0);
     vec3 g = e.xyy * phases(q + e.xyy).b + e.yyx * phases(q + e.yyx).b + e.yxy * phases(q + e.yxy).b +
              e.xxx * phases(q + e.xxx).b;
-    back = lit(kSolidColour, q, length(g) > 1e-6 ? -normalize(g) : -d);
+    back = lit(stained(kSolidColour, q, phases(q).b), q, length(g) > 1e-6 ? -normalize(g) : -d);
   } else if (THAW_SEE_BEHIND == 1 && left && tb + 1.0 < span.y) {
     // From a cell beyond the exit: at the exit itself the float field may still read above iso (the
     // exit was found on the 8-bit phases) and the medium would hit its own back face.
@@ -272,7 +296,7 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
                              : 1.0 - exp(-kWaterScattering * lw);
   float wrap = 0.5 + 0.5 * dot(n, u_light);
   vec3 light = 0.45 * ambient(n) * ao + 0.65 * wrap * sh;
-  vec3 medium = (phase == 0 ? kIceColour : kWaterColour) * light;
+  vec3 medium = (phase == 0 ? stained(kIceColour, p, phases(p).r) : kWaterColour) * light;
   vec3 body = mix(transmitted, medium, scatter);
   if (phase == 1 && water_in_front >= 0.0) {
     // Ice under water: the ice scatters as ice in front of what lies behind it, and the water in front
@@ -282,6 +306,14 @@ vec3 shade(vec3 p, vec3 n, vec3 d, vec3 inv, vec2 span, float t, int phase) {
                         max(1.0 - exp(-kIceScattering * li), kIceMinScatter));
     body = mix(ice_look * exp(-kWaterAbsorption * lf), medium, 1.0 - exp(-kWaterScattering * lf));
   }
+
+#if THAW_TINT
+  // The dye filters what passes through the path by Beer-Lambert, and scatters its own colour as a cloud of it
+  // would, opaque where thick: dilute dye is a tint over the water, a dense one the dye's colour.
+  vec3 tau = u_dye_absorption * (path_dye * u_scale);
+  float cloud = 1.0 - exp(-0.5 * max(max(tau.r, tau.g), tau.b));
+  body = mix(body * exp(-tau), u_stain_colour * light, cloud);
+#endif
 
   // Schlick's approximation of the Fresnel reflectance (Schlick 1994, "An inexpensive BRDF model for
   // physically-based rendering"), reflecting the background, plus a highlight of the key light.

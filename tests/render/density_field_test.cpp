@@ -8,12 +8,20 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <string>
 
 #include "sim/error.h"
 #include "tests/render/lattice_snapshot.h"
 
 namespace thaw {
 namespace {
+
+// Field options with `n` nodes along the longest axis.
+FieldOptions cells(int n) {
+  FieldOptions o;
+  o.max_cells = n;
+  return o;
+}
 
 constexpr float kSpacing = 0.01f;
 const Eigen::Vector3f kCentre(0.1f, -0.2f, 0.3f);
@@ -93,7 +101,7 @@ TEST(DensityField, GridCoversParticlesWithinMaxCells) {
   s.spacing = kSpacing;
   add_box(s, Eigen::Vector3f(0, 0, 0), 300, 40, 40, Phase::Water);
   for (int max_cells : {16, 64, 128}) {
-    const DensityFields f = build_density_fields(s, {max_cells, 0.5f});
+    const DensityFields f = build_density_fields(s, cells(max_cells));
     EXPECT_EQ(f.grid.nx, max_cells);
     EXPECT_LE(f.grid.ny, max_cells);
     EXPECT_LE(f.grid.nz, max_cells);
@@ -111,7 +119,7 @@ TEST(DensityField, GridCoversParticlesWithinMaxCells) {
     }
   }
   // A small particle set is not resolved finer than half a spacing.
-  const DensityFields small = build_density_fields(ice_sphere(3), {128, 0.5f});
+  const DensityFields small = build_density_fields(ice_sphere(3), cells(128));
   EXPECT_GE(small.grid.cell, 0.5f * kSpacing * 0.999f);
   EXPECT_LT(small.grid.nx, 40);
 }
@@ -135,6 +143,69 @@ TEST(DensityField, PhasesGoToTheirOwnFields) {
   const Eigen::Vector3f top =
       f.grid.origin + f.grid.cell * Eigen::Vector3f(float(f.grid.nx), float(f.grid.ny), float(f.grid.nz));
   EXPECT_LT(top.maxCoeff(), 0.5f);
+}
+
+// Coloured by a substance: the dye field is the water's concentration over the reference (the most any water
+// particle holds unless given), the stain a coating's deposit over its capacity on the solids and ice.
+TEST(DensityField, ATintBuildsTheDyeAndStainFields) {
+  RenderSnapshot s;
+  s.spacing = kSpacing;
+  add_box(s, Eigen::Vector3f(0, 0, 0), 20, 10, 10, Phase::Water);  // x < 0.1: 2 g/L, x >= 0.1: 0.5 g/L
+  add_box(s, Eigen::Vector3f(0, 0, -5 * kSpacing), 20, 10, 3, Phase::Solid);  // x < 0.1: stained half full
+  std::vector<float> c(s.position.size()), deposit(s.position.size());
+  for (std::size_t p = 0; p < s.position.size(); ++p) {
+    const bool left = s.position[p].x() < 0.1f - 1e-4f;
+    if (static_cast<Phase>(s.phase[p]) == Phase::Water) c[p] = left ? 2.0f : 0.5f;
+    if (static_cast<Phase>(s.phase[p]) == Phase::Solid) deposit[p] = left ? 1e-4f : 0.0f;
+  }
+  s.substances = {{"ink", c}};
+  s.substance_colours = {{0.2f, 0.4f, 0.6f}};
+  s.deposits = {{"ink", deposit}};
+  s.deposit_capacity = {2e-4f};
+
+  const DensityFields plain = build_density_fields(s, {});
+  EXPECT_TRUE(plain.dye.empty());
+  EXPECT_TRUE(plain.stain.empty());
+
+  FieldOptions o;
+  o.tint = "ink";
+  const DensityFields f = build_density_fields(s, o);
+  EXPECT_FLOAT_EQ(f.tint_reference, 2.0f);
+  EXPECT_EQ(f.tint_colour, (std::array<float, 3>{0.2f, 0.4f, 0.6f}));
+  ASSERT_EQ(f.dye.size(), f.grid.size());
+  ASSERT_EQ(f.stain.size(), f.grid.size());
+  const Eigen::Vector3f left(5, 5, 5), right(15, 5, 5), floor_left(5, 5, -4), floor_right(15, 5, -4);
+  EXPECT_NEAR(sample_field(f.grid, f.dye, left * kSpacing), 1.0f, 0.03f);
+  EXPECT_NEAR(sample_field(f.grid, f.dye, right * kSpacing), 0.25f, 0.01f);
+  EXPECT_LT(sample_field(f.grid, f.dye, floor_left * kSpacing), 0.01f) << "dye only in the water";
+  EXPECT_NEAR(sample_field(f.grid, f.stain, floor_left * kSpacing), 0.5f, 0.03f);
+  EXPECT_LT(sample_field(f.grid, f.stain, floor_right * kSpacing), 0.01f);
+  EXPECT_LT(sample_field(f.grid, f.stain, left * kSpacing), 0.01f) << "stain only on solids and ice";
+
+  o.tint_reference = 4.0f;
+  const DensityFields given = build_density_fields(s, o);
+  EXPECT_FLOAT_EQ(given.tint_reference, 4.0f);
+  EXPECT_NEAR(sample_field(given.grid, given.dye, left * kSpacing), 0.5f, 0.02f);
+
+  // Nothing dissolved or deposited: nothing to tint.
+  std::fill(s.substances[0].second.begin(), s.substances[0].second.end(), 0.0f);
+  std::fill(s.deposits[0].second.begin(), s.deposits[0].second.end(), 0.0f);
+  o.tint_reference = 0;
+  const DensityFields clear = build_density_fields(s, o);
+  EXPECT_TRUE(clear.dye.empty());
+  EXPECT_TRUE(clear.stain.empty());
+
+  o.tint = "salt";
+  EXPECT_THROW(
+      {
+        try {
+          build_density_fields(s, o);
+        } catch (const Error& e) {
+          EXPECT_NE(std::string(e.what()).find("'salt'"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      Error);
 }
 
 TEST(DensityField, BuildIsDeterministic) {
@@ -175,7 +246,7 @@ TEST(DensityField, EmptySnapshotGivesZeroField) {
 
 TEST(DensityField, RejectsBadInput) {
   RenderSnapshot s = ice_sphere(2);
-  EXPECT_THROW(build_density_fields(s, {4, 0.5f}), Error);
+  EXPECT_THROW(build_density_fields(s, cells(4)), Error);
   s.spacing = 0;
   EXPECT_THROW(build_density_fields(s, {}), Error);
   s.spacing = kSpacing;
@@ -203,7 +274,7 @@ TEST(DensityField, BuildTimeAt128Cubed) {
     DensityFields f;
     for (int run = 0; run < 5; ++run) {
       const auto t0 = std::chrono::steady_clock::now();
-      f = build_density_fields(s, {128, 0.5f});
+      f = build_density_fields(s, cells(128));
       best = std::min(
           best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }

@@ -405,8 +405,9 @@ TEST_F(RenderTest, AReducedMarchIsStretchedToTheImageAndShowsTheSamePicture) {
   EXPECT_EQ(again.rgba, full.rgba);
   const long full_area = silhouette(full, bg), half_area = silhouette(half, half_bg);
   const double quality = psnr(full, half);
-  std::printf("[ info ] silhouette %ld px marched in full, %ld at half scale; PSNR %.1f dB; %ld pixels differ\n",
-              full_area, half_area, quality, changed_pixels(full, half, 2));
+  std::printf(
+      "[ info ] silhouette %ld px marched in full, %ld at half scale; PSNR %.1f dB; %ld pixels differ\n",
+      full_area, half_area, quality, changed_pixels(full, half, 2));
   EXPECT_GT(full_area, 5000);
   EXPECT_NEAR(double(half_area), double(full_area), 0.04 * double(full_area));
   EXPECT_GT(quality, 24.0);
@@ -462,8 +463,8 @@ TEST_F(RenderTest, IceInAGlassCupShowsThroughItsWalls) {
     EXPECT_GT(changed(bg, glass_empty), 1000) << "the glass itself shows";
     const long water_in_glass = changed(glass_empty, render_cup(true, false, true)),
                water_in_solid = changed(solid_empty, render_cup(false, false, true));
-    std::printf("[ info ] pixels water in the cup changes: in glass %ld, in an opaque cup %ld\n", water_in_glass,
-                water_in_solid);
+    std::printf("[ info ] pixels water in the cup changes: in glass %ld, in an opaque cup %ld\n",
+                water_in_glass, water_in_solid);
     EXPECT_GT(water_in_glass, sphere_pixels) << "the water in the glass shows";
     EXPECT_LT(water_in_solid, 50) << "an opaque wall hides it";
   }
@@ -497,6 +498,78 @@ TEST_F(RenderTest, IceUnderWaterShowsThroughIt) {
     EXPECT_GT(under_water, sphere_pixels / 2);
   }
   renderer().set_quality(SurfaceRenderer::Quality::Full);
+}
+
+// The mean colour of the pixels where `image` differs from `reference`.
+Eigen::Vector3d mean_where_changed(const Image& image, const Image& reference) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  long n = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      if (differs(image, reference, x, y, 2)) {
+        for (int ch = 0; ch < 3; ++ch) sum[ch] += image.pixel(x, y)[ch];
+        ++n;
+      }
+  return sum / double(std::max(n, 1L));
+}
+
+// Coloured by a dye, water takes the dye's colour, the more the more dye it holds; none leaves it as it was.
+TEST_F(RenderTest, DyedWaterTakesTheDyesColourByItsConcentration) {
+  const OrbitCamera camera = centred_camera(0.4, 160, 120);
+  const Image bg = background(camera);
+  const DensityFields clear = sphere_fields(&DensityFields::water, 0.1f, 64);
+  const Image plain = renderer().render(clear, camera);
+  auto dyed = [&](float share) {
+    DensityFields f = clear;
+    f.dye = f.water;
+    for (float& v : f.dye) v *= share;
+    f.tint_colour = {0.78f, 0.08f, 0.30f};
+    return renderer().render(f, camera);
+  };
+  const Image none = dyed(0.0f);
+  EXPECT_LT(changed_pixels(none, plain, 2), 20) << "a dye field of zeros changes nothing";
+  double last_red_excess = -1e9;
+  for (const float share : {0.1f, 0.4f, 1.0f}) {
+    const Image image = dyed(share);
+    const Eigen::Vector3d m = mean_where_changed(image, bg);
+    const double red_excess = m[0] - m[2];
+    std::printf("[ info ] dye at %.1f of its reference: mean RGB %.0f %.0f %.0f\n", share, m[0], m[1], m[2]);
+    EXPECT_GT(red_excess, last_red_excess + 5) << "more dye, redder";
+    last_red_excess = red_excess;
+  }
+  const Eigen::Vector3d full = mean_where_changed(dyed(1.0f), bg);
+  EXPECT_GT(full[0], full[2] + 20) << "water full of a red dye reads red";
+  EXPECT_GT(full[0], full[1] + 20);
+}
+
+// A coating's stain colours the solid where it sticks, and only there.
+TEST_F(RenderTest, AStainColoursTheSolidWhereItSticks) {
+  const OrbitCamera camera = scene_camera(160, 120);
+  const DensityFields f = scene_fields(64);
+  const Image plain = renderer().render(f, camera);
+  DensityFields stained = f;
+  stained.stain.assign(f.grid.size(), 0.0f);
+  const FieldGrid& g = f.grid;
+  for (int k = 0; k < g.nz; ++k)
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        const Vector3f p = g.origin + g.cell * Vector3f(float(i), float(j), float(k));
+        if (p.x() < -0.28f)
+          stained.stain[g.index(i, j, k)] = f.solid[g.index(i, j, k)];  // the slab's end, clear of the ice
+      }
+  stained.tint_colour = {0.85f, 0.55f, 0.10f};
+  const Image image = renderer().render(stained, camera);
+  const long changed = changed_pixels(image, plain, 6);
+  const Eigen::Vector3d m = mean_where_changed(image, plain);
+  std::printf("[ info ] the stain changes %ld pixels, mean RGB %.0f %.0f %.0f\n", changed, m[0], m[1], m[2]);
+  if (std::getenv("THAW_TEST_SCREENSHOTS")) write_png("/tmp/stain-test.png", image);
+  EXPECT_GT(changed, 80);
+  EXPECT_GT(m[0], m[2] + 30) << "stained amber";
+  // Only that end, which this camera sees on the right: the left half of the image is untouched.
+  long left = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width / 2; ++x) left += differs(image, plain, x, y, 6);
+  EXPECT_LT(left, 10);
 }
 
 // A tap (an emitter) is drawn as a dryer's nozzle that never blows: the snapshot carries it after the

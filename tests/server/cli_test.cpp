@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "render/image_io.h"
+#include "server/render_options.h"
 #include "sim/scene.h"
 #include "sim/state_file.h"
 #include "tests/test_support.h"
@@ -378,6 +380,65 @@ TEST(ThawCli, FramesMeshesAndRenderedStates) {
       run_thaw("run ice-on-plate --steps 1 --set spacing=0.006 --export-mesh m --mesh-format stl", dir);
   EXPECT_EQ(fmt.exit_code, 2);
   EXPECT_NE(fmt.err.find("stl"), std::string::npos) << fmt.err;
+}
+
+// The surface view coloured by a substance tints the water that holds it: the pool of dye-in-meltwater turns
+// red (its dye's colour), less so against a higher reference concentration; a bad reference names the option.
+TEST(ThawCli, TheSurfaceViewColouredByADyeTintsTheWater) {
+  TempDir dir("cli-tint");
+  const auto r = run_thaw("run dye-in-meltwater --steps 1 --state-out s.state --quiet", dir);
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  // The mean red less blue over the picture's middle, where the pool is.
+  auto redness = [&](const std::string& options) {
+    const auto v = run_thaw("render s.state --out v.png --size 160x120 " + options, dir);
+    EXPECT_TRUE(v.exited && v.exit_code == 0) << options << "\n" << describe(v);
+    const Image image = decode_png(testing::read_file_bytes(dir.path() / "v.png"));
+    double sum = 0;
+    long n = 0;
+    for (int y = image.height / 4; y < image.height * 3 / 4; ++y)
+      for (int x = image.width / 4; x < image.width * 3 / 4; ++x, ++n)
+        sum += double(image.pixel(x, y)[0]) - double(image.pixel(x, y)[2]);
+    return sum / double(n);
+  };
+  const double plain = redness(""), dyed = redness("--colour-by substance:dye"),
+               faint = redness("--colour-by substance:dye --tint-reference 20");
+  std::printf("[ info ] red less blue: plain %.1f, dyed %.1f, against 20 g/L %.1f\n", plain, dyed, faint);
+  EXPECT_GT(dyed, plain + 10);
+  EXPECT_GT(dyed, faint + 5);
+  EXPECT_GT(faint, plain);
+  for (const char* bad : {"--tint-reference 0", "--tint-reference x"}) {
+    const auto b = run_thaw(std::string("render s.state --out b.png --colour-by substance:dye ") + bad, dir);
+    EXPECT_EQ(b.exit_code, 2) << bad;
+    EXPECT_NE(b.err.find("--tint-reference"), std::string::npos) << b.err;
+  }
+  const auto unknown = run_thaw("render s.state --out b.png --colour-by substance:ink", dir);
+  EXPECT_NE(unknown.exit_code, 0);
+  EXPECT_NE(unknown.err.find("ink"), std::string::npos) << unknown.err;
+}
+
+// A run's frames share the tint's reference, latched from the first: the dye fades as it dilutes. A new
+// substance, or an earlier time (another scene, a reset), latches anew; a given reference is kept.
+TEST(TintLatch, KeepsTheFirstFramesReferenceUntilTheSubstanceOrTheRunChanges) {
+  TintLatch latch;
+  FieldOptions wanted;
+  wanted.tint = "dye";
+  EXPECT_EQ(latch.apply(wanted, 0.0).tint_reference, 0.0f);
+  DensityFields built;
+  built.tint_reference = 2.0f;
+  latch.remember(wanted, built, 0.5);
+  EXPECT_EQ(latch.apply(wanted, 0.6).tint_reference, 2.0f);
+  built.tint_reference = 1.0f;  // the dye has spread: a later frame alone would have scaled to 1 g/L
+  latch.remember(latch.apply(wanted, 0.7), built, 0.7);
+  EXPECT_EQ(latch.apply(wanted, 0.8).tint_reference, 2.0f);
+  EXPECT_EQ(latch.apply(wanted, 0.1).tint_reference, 0.0f) << "an earlier time: another run";
+  FieldOptions salt = wanted;
+  salt.tint = "salt";
+  EXPECT_EQ(latch.apply(salt, 0.8).tint_reference, 0.0f);
+  FieldOptions given = wanted;
+  given.tint_reference = 5.0f;
+  EXPECT_EQ(latch.apply(given, 0.8).tint_reference, 5.0f);
+  FieldOptions none;
+  EXPECT_EQ(latch.apply(none, 0.8).tint_reference, 0.0f);
 }
 
 TEST(ThawCli, InfoNamesTheRenderer) {

@@ -3,6 +3,8 @@
 // published stats, snapshots and frames read from other threads.
 #include "server/session.h"
 
+#include <turbojpeg.h>
+
 #include <chrono>
 #include <future>
 #include <map>
@@ -730,6 +732,49 @@ TEST_F(RenderWorkerTest, FramesMarchAtHalfScaleWhileTheCameraMovesAndOneAtTheCho
   ASSERT_TRUE(small_moving && small_moving->frame > small->frame);
   EXPECT_EQ(small_moving->scale, 0.25);
   EXPECT_FALSE(small_moving->moving);
+  w.stop();
+}
+
+// The mean red less blue over a JPEG frame's middle half.
+double redness(const std::string& jpeg) {
+  tjhandle tj = tjInitDecompress();
+  int w = 0, h = 0, sub = 0, space = 0;
+  const auto* bytes = reinterpret_cast<const unsigned char*>(jpeg.data());
+  std::vector<unsigned char> rgb;
+  if (tjDecompressHeader3(tj, bytes, static_cast<unsigned long>(jpeg.size()), &w, &h, &sub, &space) == 0) {
+    rgb.resize(std::size_t(w) * h * 3);
+    if (tjDecompress2(tj, bytes, static_cast<unsigned long>(jpeg.size()), rgb.data(), w, 0, h, TJPF_RGB, 0) !=
+        0)
+      rgb.clear();
+  }
+  tjDestroy(tj);
+  double sum = 0;
+  long n = 0;
+  for (int y = h / 4; !rgb.empty() && y < h * 3 / 4; ++y)
+    for (int x = w / 4; x < w * 3 / 4; ++x, ++n)
+      sum += double(rgb[(std::size_t(y) * w + x) * 3]) - double(rgb[(std::size_t(y) * w + x) * 3 + 2]);
+  return n ? sum / double(n) : -1e9;
+}
+
+// view.set's colouring by a substance reaches the surface view: the paused scene's next frame has its pool
+// tinted by the dye, and back to the phases it is as it was.
+TEST_F(RenderWorkerTest, ColouredByADyeTheSurfaceFrameTintsThePool) {
+  Session s(cl(), "dye-in-meltwater", {}, (dir_.path() / "states").string());  // not started
+  RenderWorker w(s);
+  w.set_quality(160, 120, 90, 60.0, "fast", 1.0);
+  w.start();
+  auto plain = w.wait_for_frame(0, 30s);
+  ASSERT_TRUE(plain) << "the surface view needs EGL (as RenderTest does): " << w.status();
+  w.set_view("surface", "substance:dye");
+  auto dyed = w.wait_for_frame(plain->frame, 30s);
+  ASSERT_TRUE(dyed && dyed->frame > plain->frame) << w.status();
+  w.set_view("surface", "phase");
+  auto again = w.wait_for_frame(dyed->frame, 30s);
+  ASSERT_TRUE(again && again->frame > dyed->frame) << w.status();
+  const double r0 = redness(plain->jpeg), r1 = redness(dyed->jpeg), r2 = redness(again->jpeg);
+  std::printf("[ info ] red less blue: by phase %.1f, by dye %.1f, by phase again %.1f\n", r0, r1, r2);
+  EXPECT_GT(r1, r0 + 8);
+  EXPECT_NEAR(r2, r0, 1.0);
   w.stop();
 }
 

@@ -5,6 +5,7 @@
 // resolution.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -168,6 +169,29 @@ TEST(SubstanceScene, MistakesNameTheirPath) {
     doc["fluids"][0]["substances"]["dye"]["concentration"] = 2;
     doc["substances"]["dye"]["diffusivity"] = -1e-9;
     EXPECT_THROW(scene_from_json(doc), SceneError);
+  }
+}
+
+// A substance's colour: #rrggbb, or by its place among the scene's substances; anything else names its path.
+TEST(SubstanceScene, AColourIsHexOrTheSubstancesPlaceInThePalette) {
+  Json doc = dyed_tank(false);  // dye and salt
+  doc["substances"]["ink"] = {{"colour", "#FF8000"}};
+  const Scene scene = scene_from_json(doc);
+  ASSERT_EQ(scene.substances.size(), 3u);
+  ASSERT_EQ(scene.substances[2].name, "ink");
+  EXPECT_EQ(scene.substances[2].colour, (std::array<float, 3>{1.0f, 128.0f / 255.0f, 0.0f}));
+  EXPECT_NE(scene.substances[0].colour, scene.substances[1].colour) << "the palette gives each its own";
+  doc["substances"].erase("ink");
+  EXPECT_EQ(scene_from_json(doc).substances[0].colour, scene.substances[0].colour);
+  for (const char* bad : {"red", "#12345", "#12345g", "123456"}) {
+    doc["substances"]["dye"]["colour"] = bad;
+    try {
+      scene_from_json(doc);
+      FAIL() << "the colour '" << bad << "' was accepted";
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("substances.dye.colour"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("#rrggbb"), std::string::npos) << e.what();
+    }
   }
 }
 
