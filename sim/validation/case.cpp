@@ -33,7 +33,7 @@ const std::vector<ValidationCase>& validation_cases() {
       air_sphere_case(),    air_water_case(),        surface_area_case(),  ambient_sphere_case(),
       laplace_case(),       drop_oscillation_case(), contact_angle_case(), diffusion_bulk_case(),
       brine_melting_case(), conservation_case(),     adsorption_case(),    surface_diffusion_case(),
-      coating_case(),       cleansing_case()};
+      coating_case(),       cleansing_case(),        marangoni_case()};
   return cases;
 }
 

@@ -69,6 +69,7 @@ ValidationCase adsorption_case();
 ValidationCase surface_diffusion_case();
 ValidationCase coating_case();
 ValidationCase cleansing_case();
+ValidationCase marangoni_case();
 
 // A scene of ice held in still air, for the surface cases (sim/validation/surface_area.cpp): the cube
 // [-half, half]^3 at spacing dx without gravity, the ambient at air_temperature through h, heat.exposed_area

@@ -1,7 +1,12 @@
 #pragma once
-// What the substance cases on held particles share (sim/validation/surface_transport.cpp, deposits.cpp):
-// stepping with samples between, the substance's closure as a metric, and the small fits they take.
+// What the substance cases share (sim/validation/surface_transport.cpp, deposits.cpp, marangoni.cpp):
+// stepping with samples between, the substance's closure as a metric, the small fits they take, and a
+// surface coverage set by hand with the forces it makes.
+#include <Eigen/Core>
 #include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -40,6 +45,20 @@ double run_sampled(Solver& solver, double t_end, int samples, F at) {
   }
   return wall;
 }
+
+// The state `scene` starts from with its first substance (surface-active) on the water's free surface at
+// Gamma = theta Gamma_max shape(x, y, z), on each particle with a surface area (after a warm-up that measures
+// the areas); the books start from these amounts.
+SimState with_surface_coverage(ClRuntime& cl, const Scene& scene, double theta,
+                               const std::function<double(double, double, double)>& shape);
+
+// Each particle's position and the force on it over a solver's second step from `st` [N] (its mass times
+// its velocity change over the step), by particle id: the first step renews what the substance stage
+// derives from the start (the tension ratios).
+struct StepForce {
+  Eigen::Vector3d x, f;
+};
+std::map<std::uint32_t, StepForce> second_step_forces(ClRuntime& cl, const Scene& scene, const SimState& st);
 
 // The case's result: the run's size, steps and wall time, its own metrics, then substance `substance`'s
 // closure (its total now against the start's) relative to the start's, gated by `gate`.

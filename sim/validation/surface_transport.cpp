@@ -251,3 +251,51 @@ void require_held(const Json& params, const std::string& cases) {
 }
 
 }  // namespace thaw
+
+namespace thaw {
+
+SimState with_surface_coverage(ClRuntime& cl, const Scene& scene, double theta,
+                               const std::function<double(double, double, double)>& shape) {
+  if (scene.substances.empty() || !scene.substances[0].surface_active())
+    throw Error("with_surface_coverage: the scene's first substance must be surface-active");
+  Solver areas(cl, scene, initial_state(scene));
+  areas.warm_up();
+  SimState st = areas.state();
+  HostParticles& p = st.particles;
+  const HostColumn* area_column = p.column("surface_area");
+  HostColumn* col = p.column(adsorbed_field(scene.substances[0].name).name);
+  if (!area_column || !col)
+    throw Error("with_surface_coverage: the state has no surface areas or no surface amounts");
+  const float* area = area_column->as<float>();
+  const double dx = scene.spacing, capacity = scene.substances[0].surface_capacity;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (area[i] <= kSurfaceMinArea * dx * dx) continue;
+    const double amount =
+        theta * capacity * area[i] * shape(p.position[i][0], p.position[i][1], p.position[i][2]);
+    col->as<Float2>()[i] = {static_cast<float>(amount), 0.0f};
+  }
+  st.substances.clear();  // the books start from these amounts
+  return st;
+}
+
+std::map<std::uint32_t, StepForce> second_step_forces(ClRuntime& cl, const Scene& scene, const SimState& st) {
+  Solver s(cl, scene, st);
+  s.step();
+  const HostParticles a = s.particles();
+  const double t1 = s.time();
+  s.step();
+  const HostParticles b = s.particles();
+  const double dt = s.time() - t1;
+  std::map<std::uint32_t, Eigen::Vector3d> before;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    before[a.id[i]] = Eigen::Vector3d(a.velocity[i][0], a.velocity[i][1], a.velocity[i][2]);
+  std::map<std::uint32_t, StepForce> out;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const Eigen::Vector3d v(b.velocity[i][0], b.velocity[i][1], b.velocity[i][2]);
+    out[b.id[i]] = {Eigen::Vector3d(b.position[i][0], b.position[i][1], b.position[i][2]),
+                    double(b.position[i][3]) * (v - before.at(b.id[i])) / dt};
+  }
+  return out;
+}
+
+}  // namespace thaw

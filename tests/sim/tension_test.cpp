@@ -13,6 +13,8 @@
 #include "sim/state_file.h"
 #include "sim/substance_stage.h"
 #include "sim/tension_stage.h"
+#include "sim/validation/case.h"
+#include "sim/validation/substance_cases.h"
 #include "tests/test_support.h"
 
 namespace thaw {
@@ -212,28 +214,6 @@ TEST_F(TensionTest, TheSurfaceForceOnAStillDropAddsUpToLaplaces) {
   EXPECT_LT(std::hypot(net[0], net[1], net[2]) / laplace, 0.01);
 }
 
-// A still drop (as above) whose surface holds a detergent, with the exchange and the surface diffusion off
-// so it stays where it is put: theta = Gamma / Gamma_max on every surface particle (the surface stage's
-// areas), scaled by `shape`(x, y, z) (1: uniform). Returns the state after warm-up with the amounts in place.
-SimState with_detergent(ClRuntime& cl, const Scene& scene, double theta,
-                        const std::function<double(double, double, double)>& shape) {
-  Solver areas(cl, scene, initial_state(scene));
-  areas.warm_up();
-  SimState st = areas.state();
-  HostParticles& p = st.particles;
-  const float* area = p.column("surface_area")->as<float>();
-  HostColumn* col = p.column(adsorbed_field("soap").name);
-  const double dx = scene.spacing, capacity = scene.substances[0].surface_capacity;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (area[i] <= kSurfaceMinArea * dx * dx) continue;
-    const double amount =
-        theta * capacity * area[i] * shape(p.position[i][0], p.position[i][1], p.position[i][2]);
-    col->as<Float2>()[i] = {static_cast<float>(amount), 0.0f};
-  }
-  st.substances.clear();  // the books start from these amounts
-  return st;
-}
-
 Json detergent(double tension_scale, const std::string& law) {
   return {{"soap",
            {{"kind", "surface_active"},
@@ -244,31 +224,6 @@ Json detergent(double tension_scale, const std::string& law) {
             {"surface_capacity", 1e-6},
             {"tension_law", law},
             {"tension_scale", tension_scale}}}};
-}
-
-// Each particle's position and force over the second step [N], by id (the first step renews the tension
-// ratios from the detergent).
-struct Pull {
-  Eigen::Vector3d x, f;
-};
-std::map<std::uint32_t, Pull> second_step_forces(ClRuntime& cl, const Scene& scene, const SimState& st) {
-  Solver s(cl, scene, st);
-  s.step();
-  const HostParticles a = s.particles();
-  const double t1 = s.time();
-  s.step();
-  const HostParticles b = s.particles();
-  const double dt = s.time() - t1;
-  std::map<std::uint32_t, Eigen::Vector3d> before;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    before[a.id[i]] = Eigen::Vector3d(a.velocity[i][0], a.velocity[i][1], a.velocity[i][2]);
-  std::map<std::uint32_t, Pull> out;
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    const Eigen::Vector3d v(b.velocity[i][0], b.velocity[i][1], b.velocity[i][2]);
-    out[b.id[i]] = {Eigen::Vector3d(b.position[i][0], b.position[i][1], b.position[i][2]),
-                    double(b.position[i][3]) * (v - before.at(b.id[i])) / dt};
-  }
-  return out;
 }
 
 // Szyszkowski's law with E = sigma0 / (2 ln 2) at half coverage halves the tension: the drop's pull towards
@@ -285,7 +240,7 @@ TEST_F(TensionTest, ADetergentLowersTheLaplacePullBySzyszkowskisLaw) {
   const Scene plain = scene_from_json(doc);
   doc["substances"] = detergent(E, "szyszkowski");
   const Scene lowered = scene_from_json(doc);
-  const SimState st = with_detergent(cl(), plain, 0.5, [](double, double, double) { return 1.0; });
+  const SimState st = with_surface_coverage(cl(), plain, 0.5, [](double, double, double) { return 1.0; });
   const auto fp = second_step_forces(cl(), plain, st), fl = second_step_forces(cl(), lowered, st);
   double less = 0;  // how much weaker the pull towards the centre is
   for (const auto& [id, l] : fl) {
@@ -298,33 +253,11 @@ TEST_F(TensionTest, ADetergentLowersTheLaplacePullBySzyszkowskisLaw) {
   EXPECT_NEAR(less / (0.5 * laplace), 1.0, 0.12);
 }
 
-// Marangoni's stress: a flat layer of water (periodic along y and z, on a plane) whose surface holds a
-// detergent varying as 1 + eps sin(k y) along it, under the linear law. The second step's forces along y,
-// less those of the same layer with the detergent spread evenly, add up to the surface gradient of sigma
-// over the surface: sum_i f_y,i cos(k y_i) = int dsigma/dy cos(k y) dA = -E theta eps k L_y L_z / 2.
-TEST_F(TensionTest, AnUnevenDetergentPullsTheSurfaceTowardTheHigherTension) {
-  Json doc = block_scene({{"model", "brackbill1992"}});
-  const double L = 0.012;
-  doc["domain"] = {{"min", {-0.004, 0.0, 0.0}}, {"max", {0.012, L, L}}};
-  doc["solver"]["periodic"] = {"y", "z"};
-  doc["solver"]["max_dt"] = 1e-6;
-  doc["solids"] = Json::parse(R"([{"shape": "plane", "material": "glass", "point": [0, 0, 0],
-                                   "normal": [1, 0, 0]}])");
-  doc["materials"]["glass"] = {
-      {"kind", "solid"}, {"density", 2500}, {"conductivity", 1}, {"specific_heat", 800}};
-  doc["fluids"] = {{{"material", "water"}, {"box", {{"min", {0.0, 0.0, 0.0}}, {"max", {0.005, L, L}}}}}};
-  const double sigma0 = 0.0756, E = 0.02, theta = 0.5, eps = 0.5, k = 2.0 * std::numbers::pi / L;
-  doc["substances"] = detergent(E, "linear");
-  const Scene scene = scene_from_json(doc);
-  const SimState even = with_detergent(cl(), scene, theta, [](double, double, double) { return 1.0; });
-  const SimState uneven = with_detergent(
-      cl(), scene, theta, [&](double, double y, double) { return 1.0 + eps * std::sin(k * y); });
-  const auto fe = second_step_forces(cl(), scene, even), fu = second_step_forces(cl(), scene, uneven);
-  double along = 0;
-  for (const auto& [id, u] : fu) along += (u.f.y() - fe.at(id).f.y()) * std::cos(k * u.x.y());
-  const double expected = -E * theta * eps * k * L * L / 2.0;
-  std::printf("[ info ] Marangoni: %.4g N against %.4g N (sigma0 %.4g N/m)\n", along, expected, sigma0);
-  EXPECT_NEAR(along / expected, 1.0, 0.15);
+// Marangoni's stress (sim/validation/marangoni.cpp): the force's first mode along a layer whose surface holds
+// a detergent at theta (1 + eps sin k y), against L int dsigma/dy cos(k y) dy from the law, with each law.
+TEST_F(TensionTest, MarangoniCasePassesAtCiResolutionWithEachLaw) {
+  testing::expect_case_passes(run_validation(cl(), "marangoni", 12, {}));
+  testing::expect_case_passes(run_validation(cl(), "marangoni", 12, {"law=szyszkowski", "coverage=0.6"}));
 }
 
 // The pair models scale a pair's cohesion by the mean of its two tensions, so a detergent spread unevenly
@@ -335,7 +268,7 @@ TEST_F(TensionTest, PairForcesUnderAnUnevenDetergentMoveNoMomentum) {
     doc["substances"] = detergent(0.03, "szyszkowski");
     const Scene scene = scene_from_json(doc);
     const SimState st =
-        with_detergent(cl(), scene, 0.45, [](double, double, double z) { return 1.0 + 80.0 * z; });
+        with_surface_coverage(cl(), scene, 0.45, [](double, double, double z) { return 1.0 + 80.0 * z; });
     Solver s(cl(), scene, st);
     for (int k = 0; k < 60; ++k) s.step();
     const HostParticles p = s.particles();
@@ -384,7 +317,7 @@ TEST_F(TensionTest, ARunWithALoweredTensionResumesBitwise) {
   doc["substances"]["soap"]["desorption_rate"] = 1.0;
   const Scene scene = scene_from_json(doc);
   const SimState start =
-      with_detergent(cl(), scene, 0.4, [](double, double, double z) { return 1.0 + 60.0 * z; });
+      with_surface_coverage(cl(), scene, 0.4, [](double, double, double z) { return 1.0 + 60.0 * z; });
   EXPECT_TRUE(testing::resumes_bitwise(cl(), scene, start, 12, 10, "tension-resume"));
 }
 
