@@ -1,7 +1,10 @@
 #include "server/service.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "sim/scene.h"
@@ -62,13 +65,24 @@ Json emitters_json(const Scene& s) {
   return out;
 }
 
-// The scene's substances, each with its kind, in the order the scene declares them: what substance.drop
-// names.
+// "#rrggbb" of an sRGB colour in [0, 1].
+std::string hex_colour(const std::array<float, 3>& c) {
+  char text[8];
+  std::snprintf(text, sizeof text, "#%02x%02x%02x", int(std::lround(std::clamp(c[0], 0.0f, 1.0f) * 255.0f)),
+                int(std::lround(std::clamp(c[1], 0.0f, 1.0f) * 255.0f)),
+                int(std::lround(std::clamp(c[2], 0.0f, 1.0f) * 255.0f)));
+  return text;
+}
+
+// The scene's substances, each with its kind and colour, in the order the scene declares them: what
+// substance.drop names.
 Json substance_names(const Scene& s) {
   Json out = Json::array();
   for (const Substance& sub : s.substances)
-    out.push_back(
-        {{"name", sub.name}, {"kind", name(sub.kind)}, {"lowers_melting_point", sub.lowers_melting_point()}});
+    out.push_back({{"name", sub.name},
+                   {"kind", name(sub.kind)},
+                   {"lowers_melting_point", sub.lowers_melting_point()},
+                   {"colour", hex_colour(sub.colour)}});
   return out;
 }
 

@@ -109,6 +109,8 @@ function applyScene(m) {
     const o = document.createElement('option');
     o.value = `substance:${x.name}`;
     o.textContent = `by ${x.name} (g/L)`;
+    // Its colour: what the surface view tints the water with.
+    if (x.colour) o.style.color = x.colour;
     colour.appendChild(o);
   }
   fillSelect($('dryer'), indices(dryers), '0');

@@ -211,11 +211,15 @@ async def scenario(call, js, until):
     await js("{ const s = document.getElementById('substance'); s.value = 'detergent'; s.dispatchEvent(new Event('change')); }")
     print("on surface", bool(await until(f"/[0-9.]+ (g|mg|µg) on the surface/.test({TOTAL}) && !/on solids/.test({TOTAL}) && !/e-/.test({TOTAL})", 20)))
     print("[ info ] " + await js(TOTAL))
+    # The surface view coloured by the grease (the scene's #9c6b1c, shown in the menu) stains the plate.
+    print("swatch", await js("document.querySelector('#colour-by option[value=\"substance:grease\"]').style.color"))
+    await js("{ document.getElementById('view-kind').value = 'surface'; document.getElementById('colour-by').value = 'substance:grease'; document.getElementById('colour-by').dispatchEvent(new Event('change')); }")
+    print("tinted", bool(await until("document.getElementById('view-kind').value === 'surface' && document.getElementById('colour-by').value === 'substance:grease' && document.getElementById('message').textContent === '' && framesSeen > 0", 20)))
 )py"),
                                             240, &status);
   EXPECT_EQ(status, 0) << out;
   expect_lines(out, {"connected True", "panel True", "books True", "on solids True", "on surface True",
-                     "screenshot True"});
+                     "swatch rgb(156, 107, 28)", "tinted True", "screenshot True"});
   // THAW_TEST_SCREENSHOTS=DIR keeps the page.
   if (const char* keep = std::getenv("THAW_TEST_SCREENSHOTS"))
     std::filesystem::copy_file(dir.path() / "browser.png",
