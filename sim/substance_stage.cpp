@@ -172,7 +172,11 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   if (ice_pass_) k_ice_ = cl::Kernel(program, "substance_ice");
   k_diffuse_ = cl::Kernel(program, "substance_diffuse");
   if (surface_) k_norm_ = cl::Kernel(program, "substance_norm");
-  if (deposit_) k_wet_ = cl::Kernel(program, "substance_wet");
+  if (deposit_) {
+    k_wet_ = cl::Kernel(program, "substance_wet");
+    k_cells_ = cl::Kernel(program, "substance_cells");
+    k_around_ = cl::Kernel(program, "substance_cells_around");
+  }
 
   // Zeros past the particles too: the walk's lanes read a few floats beyond each cell's last one. The
   // blocks: M, A, W per substance; with surface-active ones AS, NRM, MOM, PX, PY, PZ, NX, NY, NZ, G per
@@ -332,8 +336,19 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
     launch(q, k_norm_, layout_.n);
   }
   if (deposit_) {
-    set_args(k_wet_, store_[core_.position], store_[core_.phase], nv.soa, sub_, nv.cell_start, nv.grid,
+    const std::size_t cells = std::size_t(nv.grid.nx) * std::size_t(nv.grid.ny) * std::size_t(nv.grid.nz);
+    if (cells != wet_cell_count_) {
+      held_cells_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(cells, 1));
+      around_cells_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(cells, 1));
+      wet_cell_count_ = cells;
+    }
+    set_args(k_cells_, sub_, store_[core_.phase], nv.cell_start, held_cells_, static_cast<cl_uint>(cells),
              params_);
+    launch(q, k_cells_, cells);
+    set_args(k_around_, held_cells_, around_cells_, nv.grid, static_cast<cl_uint>(cells));
+    launch(q, k_around_, cells);
+    set_args(k_wet_, store_[core_.position], store_[core_.phase], nv.soa, sub_, nv.cell_start, nv.grid,
+             params_, around_cells_);
     launch(q, k_wet_, layout_.n);
   }
   if (ice_pass_) {
@@ -381,7 +396,8 @@ void SubstanceStage::diffuse(double dt, const NeighbourView& nv) {
   }
   set_args(k_diffuse_, store_[core_.position], nv.soa, sub_, nv.cell_start, nv.grid, params_, amount(0),
            amount(1), amount(2), amount(3), on_surface(0), on_surface(1), on_surface(2), on_surface(3),
-           on_solids(0), on_solids(1), on_solids(2), on_solids(3), lowers_tension_ ? store_[ratio_] : sub_);
+           on_solids(0), on_solids(1), on_solids(2), on_solids(3), lowers_tension_ ? store_[ratio_] : sub_,
+           deposit_ ? around_cells_ : sub_);
   launch(cl_.queue(), k_diffuse_, layout_.n);
 }
 

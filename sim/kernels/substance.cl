@@ -336,16 +336,59 @@ kernel void substance_norm(global const float4* pos, global const float* soa, gl
 #endif
 
 #ifdef THAW_DEPOSIT
+/* What each grid cell holds, one work item per cell over its particles: CELL_CARRIER a carrier (M > 0),
+ * CELL_STATIC a solid or ice particle; then (substance_cells_around) what the 27 cells around it hold. A
+ * wall's inner layers, with no carrier in the cells around them, skip substance_wet's walk, and a carrier
+ * with no solid or ice around it skips the walk of the exchange with them: the coating stage cost half again
+ * on the benchmark block, whose walls outnumber its water, where no water touched a wall. */
+#define CELL_CARRIER 1
+#define CELL_STATIC 2
+kernel void substance_cells(global const float* sub, global const uchar* phase, global const uint* cell_start,
+                            global uchar* wet_cells, const uint ncells, const SubstanceParams P) {
+  const uint c = get_global_id(0);
+  if (c >= ncells) return;
+  global const float* M = sub + SUB_M * P.stride;
+  uchar held = 0;
+  for (uint j = cell_start[c]; j < cell_start[c + 1] && held != (CELL_CARRIER | CELL_STATIC); ++j)
+    held |= (M[j] > 0.0f ? CELL_CARRIER : 0) | (THAW_IS_STATIC(phase[j]) ? CELL_STATIC : 0);
+  wet_cells[c] = held;
+}
+
+/* What the cells around `cell` (the 27 the walks visit, wrapped along periodic axes) hold together. */
+uchar cells_around(const Grid g, const int4 cell, global const uchar* held) {
+  uchar all = 0;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+#ifdef THAW_PERIODIC
+        const int c = heat_cell(g, cell, dz, dy, dx);
+#else
+        const int x = cell.x + dx, y = cell.y + dy, z = cell.z + dz;
+        const int c = (x < 0 || x >= g.nx || y < 0 || y >= g.ny || z < 0 || z >= g.nz) ? -1 : (z * g.ny + y) * g.nx + x;
+#endif
+        if (c >= 0) all |= held[c];
+      }
+  return all;
+}
+
+kernel void substance_cells_around(global const uchar* held, global uchar* around, const Grid g, const uint ncells) {
+  const uint c = get_global_id(0);
+  if (c >= ncells) return;
+  const int x = (int)(c % (uint)g.nx), y = (int)(c / (uint)g.nx % (uint)g.ny), z = (int)(c / ((uint)g.nx * (uint)g.ny));
+  around[c] = cells_around(g, (int4)(x, y, z, 0), held);
+}
+
 /* Each solid or ice particle's F = face / max(sum_j M_j w(r_ij / H), wet_weight) over the other carriers j
  * within its support: its uptake from each carrier is weighted by M_j w(r_ij / H) F, so the shares sum to
  * its face where water fills the wet share of its kernel volume (substance_stage.h's kWetFraction) and to
  * less where less water touches it; no water, no uptake. */
 kernel void substance_wet(global const float4* pos, global const uchar* phase, global const float* soa,
-                          global float* sub, global const uint* cell_start, const Grid g, const SubstanceParams P) {
+                          global float* sub, global const uint* cell_start, const Grid g, const SubstanceParams P,
+                          global const uchar* around) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uint stride = P.stride;
-  if (!THAW_IS_STATIC(phase[i])) {
+  if (!THAW_IS_STATIC(phase[i]) || !(around[grid_key(g, grid_cell(g, pos[i]))] & CELL_CARRIER)) {
     sub[SUB_F * stride + i] = 0.0f;
     return;
   }
@@ -467,7 +510,7 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
                               global float2* q0, global float2* q1, global float2* q2, global float2* q3,
                               global float2* s0, global float2* s1, global float2* s2, global float2* s3,
                               global float2* d0, global float2* d1, global float2* d2, global float2* d3,
-                              global float* tension_ratio) {
+                              global float* tension_ratio, global const uchar* around) {
   const uint i = get_global_id(0);
   if (i >= P.n) return;
   const uint stride = P.stride;
@@ -517,6 +560,8 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
   const float cleanse[4] = {P.cleanse0, P.cleanse1, P.cleanse2, P.cleanse3};
   const float inv_coat_capacity[4] = {P.inv_coat_capacity0, P.inv_coat_capacity1, P.inv_coat_capacity2,
                                       P.inv_coat_capacity3};
+  /* A carrier gives to wet boundary particles only where a solid or ice particle is in the cells around. */
+  const int near_static = mi > 0.0f && (around[grid_key(g, grid_cell(g, pos[i]))] & CELL_STATIC);
   float ri[THAW_NSUB];
   uint by[THAW_NSUB]; /* each coating's cleanser, 15 for none */
   floatV dhi[THAW_NSUB], dlo[THAW_NSUB];
@@ -533,37 +578,6 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
       const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
       const floatV mj = vloadV(0, M + j);
       const floatV qr = sqrt(r2) * inv_H;
-#ifdef THAW_DEPOSIT
-      /* i a carrier gives to the wet boundary particles around it (not itself: partly melted ice is both) ... */
-      if (mi > 0.0f) {
-        const floatV f_j = vloadV(0, F + j);
-        const intV wet_j = in & (f_j > 0.0f) & (r2 > 0.0f);
-        if (any(wet_j)) {
-          const floatV wgt = select((floatV)(0.0f), mi * w_shape(qr), wet_j);
-          for (int s = 0; s < THAW_NSUB; ++s) {
-            if (!((P.coating >> s) & 1u)) continue;
-            const float wd = by[s] < THAW_NSUB ? wi[by[s]] : 0.0f;
-            const floatV g_j = vloadV(0, sub + (SUB_R + s) * stride + j);
-            const floatV given = -DEPOSITED(f_j, wgt, wi[s], wd, g_j, s);
-            ACCUMULATE(hi[s], lo[s], given)
-          }
-        }
-      }
-      /* ... and i a wet boundary particle takes from the carriers around it. */
-      if (f_i > 0.0f) {
-        const intV carrier = in & (mj > 0.0f) & (r2 > 0.0f);
-        if (any(carrier)) {
-          const floatV wgt = select((floatV)(0.0f), mj * w_shape(qr), carrier);
-          for (int s = 0; s < THAW_NSUB; ++s) {
-            if (!((P.coating >> s) & 1u)) continue;
-            const floatV wc = vloadV(0, sub + (SUB_W + s) * stride + j);
-            const floatV wd = by[s] < THAW_NSUB ? vloadV(0, sub + (SUB_W + by[s]) * stride + j) : (floatV)(0.0f);
-            const floatV taken = DEPOSITED(f_i, wgt, wc, wd, ri[s], s);
-            ACCUMULATE(dhi[s], dlo[s], taken)
-          }
-        }
-      }
-#endif
       if (mi > 0.0f) {
         /* Symmetric in i and j operand by operand (the header); 0 for lanes out of range or not water. */
         const floatV pair = select((floatV)(0.0f), (ai * vloadV(0, A + j)) * (grad_shape(qr) * r2 / (r2 + eta2)),
@@ -625,6 +639,49 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
 #endif
     }
   }
+#ifdef THAW_DEPOSIT
+  /* The exchange with solids and ice, in a walk of its own for the particles next to them: in the walk above
+   * its branches, though never taken, slowed every carrier's walk by a third on pocl. */
+  if (near_static || f_i > 0.0f) {
+    FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
+      for (uint j = jb; j < je; j += THAW_VW) {
+        PAIR_LANES(pi, j, period)
+        const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
+        const floatV mj = vloadV(0, M + j);
+        const floatV qr = sqrt(r2) * inv_H;
+        /* i a carrier gives to the wet boundary particles around it (not itself: partly melted ice is both) ... */
+        if (near_static) {
+          const floatV f_j = vloadV(0, F + j);
+          const intV wet_j = in & (f_j > 0.0f) & (r2 > 0.0f);
+          if (any(wet_j)) {
+            const floatV wgt = select((floatV)(0.0f), mi * w_shape(qr), wet_j);
+            for (int s = 0; s < THAW_NSUB; ++s) {
+              if (!((P.coating >> s) & 1u)) continue;
+              const float wd = by[s] < THAW_NSUB ? wi[by[s]] : 0.0f;
+              const floatV g_j = vloadV(0, sub + (SUB_R + s) * stride + j);
+              const floatV given = -DEPOSITED(f_j, wgt, wi[s], wd, g_j, s);
+              ACCUMULATE(hi[s], lo[s], given)
+            }
+          }
+        }
+        /* ... and i a wet boundary particle takes from the carriers around it. */
+        if (f_i > 0.0f) {
+          const intV carrier = in & (mj > 0.0f) & (r2 > 0.0f);
+          if (any(carrier)) {
+            const floatV wgt = select((floatV)(0.0f), mj * w_shape(qr), carrier);
+            for (int s = 0; s < THAW_NSUB; ++s) {
+              if (!((P.coating >> s) & 1u)) continue;
+              const floatV wc = vloadV(0, sub + (SUB_W + s) * stride + j);
+              const floatV wd = by[s] < THAW_NSUB ? vloadV(0, sub + (SUB_W + by[s]) * stride + j) : (floatV)(0.0f);
+              const floatV taken = DEPOSITED(f_i, wgt, wc, wd, ri[s], s);
+              ACCUMULATE(dhi[s], dlo[s], taken)
+            }
+          }
+        }
+      }
+    }
+  }
+#endif
   global float2* q[4] = {q0, q1, q2, q3};
   if (mi != 0.0f)
     for (int s = 0; s < THAW_NSUB; ++s) add_lanes(q[s], i, hi[s], lo[s]);
