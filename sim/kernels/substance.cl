@@ -505,6 +505,14 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
  *   dS_i/dt = sum_j 2 D_s a_i a_j (Gamma_i - Gamma_j) (p_ij . grad W2_ij) / (|p_ij|^2 + eta^2),
  * W2 the kernel's 2-D form (the same shape with sigma_2), symmetric in i and j term by term as eq. 11 asks,
  * where sec. 6.2's (a_i V_i + a_j V_j) is not a surface integral's weight. */
+/* substance_diffuse's candidates j..j+THAW_VW: offsets and r2 (PAIR_LANES), which lanes are within the support
+ * (`in`), their carried masses mj and r / H (qr). */
+#define DIFFUSE_LANES(j)                                              \
+  PAIR_LANES(pi, j, period)                                           \
+  const intV in = (THAW_LANE_IDS < (int)(je - (j))) & (r2 < H2);      \
+  const floatV mj = vloadV(0, M + (j));                               \
+  const floatV qr = sqrt(r2) * inv_H;
+
 kernel void substance_diffuse(global const float4* pos, global const float* soa, global const float* sub,
                               global const uint* cell_start, const Grid g, const SubstanceParams P,
                               global float2* q0, global float2* q1, global float2* q2, global float2* q3,
@@ -574,10 +582,7 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
 #endif
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      PAIR_LANES(pi, j, period)
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-      const floatV mj = vloadV(0, M + j);
-      const floatV qr = sqrt(r2) * inv_H;
+      DIFFUSE_LANES(j)
       if (mi > 0.0f) {
         /* Symmetric in i and j operand by operand (the header); 0 for lanes out of range or not water. */
         const floatV pair = select((floatV)(0.0f), (ai * vloadV(0, A + j)) * (grad_shape(qr) * r2 / (r2 + eta2)),
@@ -645,10 +650,7 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
   if (near_static || f_i > 0.0f) {
     FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
       for (uint j = jb; j < je; j += THAW_VW) {
-        PAIR_LANES(pi, j, period)
-        const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-        const floatV mj = vloadV(0, M + j);
-        const floatV qr = sqrt(r2) * inv_H;
+        DIFFUSE_LANES(j)
         /* i a carrier gives to the wet boundary particles around it (not itself: partly melted ice is both) ... */
         if (near_static) {
           const floatV f_j = vloadV(0, F + j);

@@ -46,6 +46,11 @@ double run_sampled(Solver& solver, double t_end, int samples, F at) {
   return wall;
 }
 
+// A surface-active substance "soap" under the tension law `law` with E = `tension_scale` [N/m] and
+// Gamma_max 1e-6 kg/m^2 that stays where it is put (no diffusion, no exchange with the bulk), as a scene's
+// `substances` block: for cases that set a coverage by hand (with_surface_coverage) and measure its forces.
+Json still_detergent(const Json& law, const Json& tension_scale);
+
 // The state `scene` starts from with its first substance (surface-active) on the water's free surface at
 // Gamma = theta Gamma_max shape(x, y, z), on each particle with a surface area (after a warm-up that measures
 // the areas); the books start from these amounts.

@@ -254,6 +254,18 @@ void require_held(const Json& params, const std::string& cases) {
 
 namespace thaw {
 
+Json still_detergent(const Json& law, const Json& tension_scale) {
+  return {{"soap",
+           {{"kind", "surface_active"},
+            {"diffusivity", 0.0},
+            {"surface_diffusivity", 0.0},
+            {"adsorption_rate", 0.0},
+            {"desorption_rate", 0.0},
+            {"surface_capacity", 1e-6},
+            {"tension_law", law},
+            {"tension_scale", tension_scale}}}};
+}
+
 SimState with_surface_coverage(ClRuntime& cl, const Scene& scene, double theta,
                                const std::function<double(double, double, double)>& shape) {
   if (scene.substances.empty() || !scene.substances[0].surface_active())

@@ -310,21 +310,26 @@ TEST_F(RenderTest, ParticleSampledSphereHasTheProjectedAreaAndPicksItsFront) {
   EXPECT_GT(normal.dot(-dir), std::cos(20.0 * M_PI / 180.0));
 }
 
+// The mean colour of the pixels where `image` differs from `reference`.
+Eigen::Vector3d mean_where_changed(const Image& image, const Image& reference) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  long n = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      if (differs(image, reference, x, y, 2)) {
+        for (int ch = 0; ch < 3; ++ch) sum[ch] += image.pixel(x, y)[ch];
+        ++n;
+      }
+  return sum / double(std::max(n, 1L));
+}
+
 TEST_F(RenderTest, IceAndWaterLookDifferent) {
   const OrbitCamera camera = centred_camera(0.4, 160, 120);
   const Image bg = background(camera);
   auto mean_colour = [&](std::vector<float> DensityFields::*phase) {
     const Image image = renderer().render(sphere_fields(phase, 0.1f, 64), camera);
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    long n = 0;
-    for (int y = 0; y < image.height; ++y)
-      for (int x = 0; x < image.width; ++x)
-        if (differs(image, bg, x, y, 2)) {
-          for (int ch = 0; ch < 3; ++ch) sum[ch] += image.pixel(x, y)[ch];
-          ++n;
-        }
-    EXPECT_GT(n, 1000);
-    return Eigen::Vector3d(sum / double(std::max(n, 1L)));
+    EXPECT_GT(changed_pixels(image, bg, 2), 1000);
+    return mean_where_changed(image, bg);
   };
   const Eigen::Vector3d ice = mean_colour(&DensityFields::ice), water = mean_colour(&DensityFields::water),
                         solid = mean_colour(&DensityFields::solid);
@@ -498,19 +503,6 @@ TEST_F(RenderTest, IceUnderWaterShowsThroughIt) {
     EXPECT_GT(under_water, sphere_pixels / 2);
   }
   renderer().set_quality(SurfaceRenderer::Quality::Full);
-}
-
-// The mean colour of the pixels where `image` differs from `reference`.
-Eigen::Vector3d mean_where_changed(const Image& image, const Image& reference) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  long n = 0;
-  for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.width; ++x)
-      if (differs(image, reference, x, y, 2)) {
-        for (int ch = 0; ch < 3; ++ch) sum[ch] += image.pixel(x, y)[ch];
-        ++n;
-      }
-  return sum / double(std::max(n, 1L));
 }
 
 // Coloured by a dye, water takes the dye's colour, the more the more dye it holds; none leaves it as it was.

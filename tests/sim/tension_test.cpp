@@ -214,17 +214,7 @@ TEST_F(TensionTest, TheSurfaceForceOnAStillDropAddsUpToLaplaces) {
   EXPECT_LT(std::hypot(net[0], net[1], net[2]) / laplace, 0.01);
 }
 
-Json detergent(double tension_scale, const std::string& law) {
-  return {{"soap",
-           {{"kind", "surface_active"},
-            {"diffusivity", 0.0},
-            {"surface_diffusivity", 0.0},
-            {"adsorption_rate", 0.0},
-            {"desorption_rate", 0.0},
-            {"surface_capacity", 1e-6},
-            {"tension_law", law},
-            {"tension_scale", tension_scale}}}};
-}
+Json detergent(double tension_scale, const std::string& law) { return still_detergent(law, tension_scale); }
 
 // Szyszkowski's law with E = sigma0 / (2 ln 2) at half coverage halves the tension: the drop's pull towards
 // its centre over the second step falls by half of Laplace's (the first step is the same in both runs, so
