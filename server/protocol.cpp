@@ -317,6 +317,7 @@ void read_view_set(ViewSet& c, const Json& v) {
       throw SceneError("colour_by", std::string(e.what()).substr(std::strlen("colour_by: ")));
     }
   }
+  c.tint_reference = opt<double>(v, "tint_reference");  // its range: the row's schema
 }
 
 void read_quality_set(QualitySet& c, const Json& v) {
@@ -384,14 +385,21 @@ std::vector<Spec> build_specs() {
        number("d_elevation", "Change of elevation").in("deg").def(0.0),
        number("zoom", "Distance factor; < 1 moves closer").def(1.0).above(0.01).at_most(100)},
       read_camera_orbit));
-  rows.push_back(
-      row<ViewSet>("view.set",
-                   {choice("view", {"surface", "particles", "slice"}, "What is drawn"),
-                    text("colour_by",
-                         "Colouring: phase, temperature, speed, or substance:<name> for one of the "
-                         "scene's substances")
-                        .optional()},
-                   read_view_set));
+  rows.push_back(row<ViewSet>(
+      "view.set",
+      {choice("view", {"surface", "particles", "slice"}, "What is drawn"),
+       text("colour_by",
+            "Colouring: phase, temperature, speed, or substance:<name> for one of the "
+            "scene's substances")
+           .optional(),
+       number("tint_reference",
+              "The surface view coloured by a substance: the concentration of full colour; 0: the "
+              "most any water holds in the first tinted frame")
+           .in("g/L")
+           .at_least(0)
+           .at_most(1e4)
+           .optional()},
+      read_view_set));
   rows.push_back(row<QualitySet>(
       "quality.set",
       {integer("width", "Image width").in("px").at_least(16).at_most(1920).optional(),

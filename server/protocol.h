@@ -89,7 +89,8 @@ struct CameraOrbit {                                // relative change, e.g. fro
 struct CameraReset {};  // back to the scene's own camera
 struct ViewSet {
   std::string view = "surface";          // surface | particles | slice
-  std::optional<std::string> colour_by;  // phase | temperature
+  std::optional<std::string> colour_by;  // phase | temperature | speed | substance:NAME
+  std::optional<double> tint_reference;  // the surface view's full-colour concentration [g/L]; 0: automatic
 };
 struct QualitySet {
   std::optional<int> width, height;    // 16 .. 1920, 16 .. 1080

@@ -292,14 +292,18 @@ void RenderWorker::orbit(double d_azimuth, double d_elevation, double zoom) {
   cv_.notify_all();
 }
 
-void RenderWorker::set_view(const std::string& view, std::optional<std::string> colour_by) {
+void RenderWorker::set_view(const std::string& view, std::optional<std::string> colour_by,
+                            std::optional<double> tint_reference) {
   if (view != "surface" && view != "particles" && view != "slice")
     throw Error("view: unknown view '" + view + "'; available: surface, particles, slice");
   if (colour_by) check_colouring(*colour_by, "colour_by");
+  if (tint_reference && !(*tint_reference >= 0 && *tint_reference <= 1e4))
+    throw Error("tint_reference: expected a concentration in [0, 1e4] g/L");
   {
     std::lock_guard lock(mutex_);
     options_.view = view;
     if (colour_by) options_.colour_by = *colour_by;
+    if (tint_reference) options_.field.tint_reference = static_cast<float>(*tint_reference);
     ++options_version_;
   }
   cv_.notify_all();

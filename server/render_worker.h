@@ -65,7 +65,10 @@ class RenderWorker {
   // Relative: degrees added to azimuth and elevation (clamped to +-89), distance multiplied by zoom.
   void orbit(double d_azimuth, double d_elevation, double zoom);
   // view: surface | particles | slice; colour_by: phase | temperature | speed.
-  void set_view(const std::string& view, std::optional<std::string> colour_by = {});
+  // `tint_reference`: the surface view's full-colour concentration when coloured by a substance [g/L]; 0:
+  // latched from the first frame (TintLatch).
+  void set_view(const std::string& view, std::optional<std::string> colour_by = {},
+                std::optional<double> tint_reference = {});
   // width 16..1920, height 16..1080, jpeg_quality 10..95, fps cap 1..60, surface full | fast, scale
   // SurfaceRenderer::kMinScale..1.
   void set_quality(std::optional<int> width, std::optional<int> height, std::optional<int> jpeg_quality,

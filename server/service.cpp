@@ -31,7 +31,13 @@ Json scene_names() {
 
 Json vec(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
-Json view_json(const RenderOptions& o) { return {{"view", o.view}, {"colour_by", o.colour_by}}; }
+Json view_json(const RenderOptions& o) {
+  // The reference is kept as a float: written to 6 digits, 0.1 reads back as 0.1 and the page's menu finds
+  // it.
+  char reference[32];
+  std::snprintf(reference, sizeof reference, "%.6g", double(o.field.tint_reference));
+  return {{"view", o.view}, {"colour_by", o.colour_by}, {"tint_reference", std::stod(reference)}};
+}
 
 // The camera as drawn now: distance 0 frames the domain, target null looks at its centre.
 Json camera_json(const RenderOptions& o) {
@@ -270,7 +276,7 @@ void Service::on_text(std::uint64_t client, std::string_view message) {
               return;
             }
           }
-          renderer_.set_view(c.view, c.colour_by);
+          renderer_.set_view(c.view, c.colour_by, c.tint_reference);
           done({}, "", Json::object());
         } else if constexpr (std::is_same_v<T, QualitySet>) {
           renderer_.set_quality(c.width, c.height, c.jpeg_quality, c.fps, c.surface, c.scale);

@@ -143,6 +143,7 @@ function applyView(view, quality) {
   if (view) {
     $('view-kind').value = view.view;
     $('colour-by').value = view.colour_by;
+    if (view.tint_reference !== undefined) showChoice('tint-reference', view.tint_reference, (v) => `${v} g/L`);
   }
   if (quality && quality.surface) $('full-quality').checked = quality.surface === 'full';
   if (quality && quality.scale !== undefined) showChoice('scale', quality.scale, (v) => `${Math.round(100 * Number(v))} %`);
@@ -496,9 +497,15 @@ $('emitter-temp').addEventListener('change', (e) => {
   send('emitter.set', { emitter: currentEmitter(), temperature: Number(e.target.value) });
 });
 
-const sendView = () => send('view.set', { view: $('view-kind').value, colour_by: $('colour-by').value });
+const sendView = () =>
+  send('view.set', {
+    view: $('view-kind').value,
+    colour_by: $('colour-by').value,
+    tint_reference: Number($('tint-reference').value),
+  });
 $('view-kind').addEventListener('change', sendView);
 $('colour-by').addEventListener('change', sendView);
+$('tint-reference').addEventListener('change', sendView);
 $('full-quality').addEventListener('change', (e) => send('quality.set', { surface: e.target.checked ? 'full' : 'fast' }));
 $('scale').addEventListener('change', (e) => send('quality.set', { scale: Number(e.target.value) }));
 

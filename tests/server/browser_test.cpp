@@ -215,11 +215,14 @@ async def scenario(call, js, until):
     print("swatch", await js("document.querySelector('#colour-by option[value=\"substance:grease\"]').style.color"))
     await js("{ document.getElementById('view-kind').value = 'surface'; document.getElementById('colour-by').value = 'substance:grease'; document.getElementById('colour-by').dispatchEvent(new Event('change')); }")
     print("tinted", bool(await until("document.getElementById('view-kind').value === 'surface' && document.getElementById('colour-by').value === 'substance:grease' && document.getElementById('message').textContent === '' && framesSeen > 0", 20)))
+    # Full colour at 10 g/L: the server keeps it, so the stats that follow leave the menu there.
+    await js("{ const t = document.getElementById('tint-reference'); t.value = '10'; t.dispatchEvent(new Event('change')); t.blur(); window.statsBefore = history.length; }")
+    print("reference", bool(await until("history.length > window.statsBefore + 2 && document.getElementById('tint-reference').value === '10' && document.getElementById('message').textContent === ''", 20)))
 )py"),
                                             240, &status);
   EXPECT_EQ(status, 0) << out;
   expect_lines(out, {"connected True", "panel True", "books True", "on solids True", "on surface True",
-                     "swatch rgb(156, 107, 28)", "tinted True", "screenshot True"});
+                     "swatch rgb(156, 107, 28)", "tinted True", "reference True", "screenshot True"});
   // THAW_TEST_SCREENSHOTS=DIR keeps the page.
   if (const char* keep = std::getenv("THAW_TEST_SCREENSHOTS"))
     std::filesystem::copy_file(dir.path() / "browser.png",

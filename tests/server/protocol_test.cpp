@@ -283,6 +283,11 @@ TEST(ProtocolParse, ViewAndQuality) {
   EXPECT_FALSE(slice.colour_by);
   EXPECT_EQ(parsed<ViewSet>(R"({"type":"view.set","view":"slice","colour_by":"substance:salt"})").colour_by,
             "substance:salt");
+  EXPECT_FALSE(slice.tint_reference);
+  EXPECT_EQ(parsed<ViewSet>(
+                R"({"type":"view.set","view":"surface","colour_by":"substance:dye","tint_reference":20})")
+                .tint_reference,
+            20.0);
 
   const QualitySet q = parsed<QualitySet>(valid_messages()[14]);
   EXPECT_EQ(q.width, 640);
@@ -599,6 +604,8 @@ TEST(ProtocolRefuse, ViewAndQuality) {
       {R"({"type":"view.set","view":"surface","colour_by":"velocity"})", "view.set", "colour_by"},
       {R"({"type":"view.set","view":"surface","colour_by":"substance:"})", "view.set", "colour_by"},
       {R"({"type":"view.set","view":"surface","colour_by":3})", "view.set", "colour_by"},
+      {R"({"type":"view.set","view":"surface","tint_reference":-1})", "view.set", "tint_reference"},
+      {R"({"type":"view.set","view":"surface","tint_reference":"2"})", "view.set", "tint_reference"},
       {R"({"type":"quality.set","width":15})", "quality.set", "width"},
       {R"({"type":"quality.set","width":1921})", "quality.set", "width"},
       {R"({"type":"quality.set","width":640.5})", "quality.set", "width"},

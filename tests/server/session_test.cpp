@@ -757,7 +757,7 @@ double redness(const std::string& jpeg) {
 }
 
 // view.set's colouring by a substance reaches the surface view: the paused scene's next frame has its pool
-// tinted by the dye, and back to the phases it is as it was.
+// tinted by the dye, fainter against a higher reference, and back to the phases it is as it was.
 TEST_F(RenderWorkerTest, ColouredByADyeTheSurfaceFrameTintsThePool) {
   Session s(cl(), "dye-in-meltwater", {}, (dir_.path() / "states").string());  // not started
   RenderWorker w(s);
@@ -768,12 +768,23 @@ TEST_F(RenderWorkerTest, ColouredByADyeTheSurfaceFrameTintsThePool) {
   w.set_view("surface", "substance:dye");
   auto dyed = w.wait_for_frame(plain->frame, 30s);
   ASSERT_TRUE(dyed && dyed->frame > plain->frame) << w.status();
-  w.set_view("surface", "phase");
-  auto again = w.wait_for_frame(dyed->frame, 30s);
-  ASSERT_TRUE(again && again->frame > dyed->frame) << w.status();
-  const double r0 = redness(plain->jpeg), r1 = redness(dyed->jpeg), r2 = redness(again->jpeg);
-  std::printf("[ info ] red less blue: by phase %.1f, by dye %.1f, by phase again %.1f\n", r0, r1, r2);
+  // Full colour at 20 g/L, ten times the pool's: a fainter tint.
+  w.set_view("surface", "substance:dye", 20.0);
+  auto faint = w.wait_for_frame(dyed->frame, 30s);
+  ASSERT_TRUE(faint && faint->frame > dyed->frame) << w.status();
+  EXPECT_EQ(w.options().field.tint_reference, 20.0f);
+  EXPECT_THROW(w.set_view("surface", "substance:dye", -1.0), Error);
+  w.set_view("surface", "phase", 0.0);
+  auto again = w.wait_for_frame(faint->frame, 30s);
+  ASSERT_TRUE(again && again->frame > faint->frame) << w.status();
+  const double r0 = redness(plain->jpeg), r1 = redness(dyed->jpeg), r2 = redness(again->jpeg),
+               r3 = redness(faint->jpeg);
+  std::printf(
+      "[ info ] red less blue: by phase %.1f, by dye %.1f, against 20 g/L %.1f, by phase again %.1f\n", r0,
+      r1, r3, r2);
   EXPECT_GT(r1, r0 + 8);
+  EXPECT_GT(r1, r3 + 5);
+  EXPECT_GT(r3, r0);
   EXPECT_NEAR(r2, r0, 1.0);
   w.stop();
 }
