@@ -199,12 +199,11 @@ void tint_weights(const RenderSnapshot& s, const FieldOptions& o, const SlotAt& 
   for (std::size_t k = 0; k < s.deposits.size(); ++k) {
     const auto& [name, deposit] = s.deposits[k];
     if (name != o.tint || deposit.size() != s.position.size()) continue;
-    float full = k < s.deposit_capacity.size() ? s.deposit_capacity[k] : 0.0f;
-    if (!(full > 0))
-      for (float v : deposit) full = std::max(full, std::isfinite(v) ? v : 0.0f);
-    bool any = false;
-    for (float v : deposit) any = any || v > 0;
-    if (!any || !(full > 0)) break;
+    float most = 0;  // the most any particle holds
+    for (float v : deposit) most = std::max(most, std::isfinite(v) ? v : 0.0f);
+    const float capacity = k < s.deposit_capacity.size() ? s.deposit_capacity[k] : 0.0f;
+    const float full = capacity > 0 ? capacity : most;
+    if (!(most > 0)) break;
     stain.assign(deposit.size(), 0.0f);
     for (std::size_t p = 0; p < deposit.size(); ++p) {
       const int slot = slot_at(p);

@@ -22,6 +22,9 @@ struct FieldGrid {
   std::size_t index(int i, int j, int k) const { return (std::size_t(k) * ny + j) * nx + i; }
 };
 
+// The most a tint's full-colour concentration may be set to [g/L] (--tint-reference, view.set).
+inline constexpr double kMaxTintReference = 1e4;
+
 struct FieldOptions {
   int max_cells = 128;  // nodes along the longest axis of the particles' bounds (plus margins)
   float iso = 0.5f;     // surface level

@@ -16,8 +16,8 @@ int cmd_info(int argc, char** argv) {
   std::printf("OpenCL devices:\n");
   if (all.empty()) std::printf("  (none: no ICD driver found in /etc/OpenCL/vendors)\n");
   for (const auto& d : all)
-    std::printf("  %d:%d  %-4s %s  [%s]  %s, %u compute units, %.1f GiB\n", d.platform, d.device, d.type.c_str(),
-                d.name.c_str(), d.platform_name.c_str(), d.version.c_str(), d.compute_units,
+    std::printf("  %d:%d  %-4s %s  [%s]  %s, %u compute units, %.1f GiB\n", d.platform, d.device,
+                d.type.c_str(), d.name.c_str(), d.platform_name.c_str(), d.version.c_str(), d.compute_units,
                 double(d.global_memory) / (1024.0 * 1024.0 * 1024.0));
   int status = 0;
   try {

@@ -28,7 +28,8 @@ void on_signal(int) { g_stop = true; }
 }  // namespace
 
 int cmd_serve(int argc, char** argv) {
-  CliArgs args(argc, argv, 2, {"--host", "--port", "--token", "--state-dir", "--state-out", "--device", "--web"},
+  CliArgs args(argc, argv, 2,
+               {"--host", "--port", "--token", "--state-dir", "--state-out", "--device", "--web"},
                {"--quiet"});
   if (args.positional().size() > 1) throw Error("serve takes at most one scene");
   const std::string scene = args.positional().empty() ? "default" : args.positional()[0];
@@ -43,7 +44,8 @@ int cmd_serve(int argc, char** argv) {
   service_options.loopback = net.host == "127.0.0.1" || net.host == "localhost";
   // Anyone who can reach a non-loopback address could steer the simulation: require a token there.
   if (!service_options.loopback && service_options.token.empty())
-    throw Error("--host " + net.host + ": serving beyond 127.0.0.1 needs --token TOKEN (clients without it watch)");
+    throw Error("--host " + net.host +
+                ": serving beyond 127.0.0.1 needs --token TOKEN (clients without it watch)");
 
   // Frames go ahead of steps: a picture that answers a command within 200 ms matters more to someone
   // steering than the last few steps a second. The OpenCL runtime starts in a thread at a lower

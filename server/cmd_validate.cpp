@@ -25,11 +25,11 @@ int cmd_validate(int argc, char** argv) {
   if (args.flag("--json")) {
     std::printf("%s\n", r.to_json().dump(2).c_str());
   } else {
-    std::printf("%s at res %d: %zu particles, %llu steps, %.2f s wall on %s\n", r.name.c_str(), r.res, r.particles,
-                (unsigned long long)r.steps, r.wall_s, cl.description().c_str());
+    std::printf("%s at res %d: %zu particles, %llu steps, %.2f s wall on %s\n", r.name.c_str(), r.res,
+                r.particles, (unsigned long long)r.steps, r.wall_s, cl.description().c_str());
     for (const auto& [key, m] : r.metrics)
-      std::printf("  %-28s value %-12.6g reference %-12.6g error %-10.4g gate %-8.4g %s\n", key.c_str(), m.value,
-                  m.reference, m.error, m.gate, m.passed() ? "ok" : "FAILED");
+      std::printf("  %-28s value %-12.6g reference %-12.6g error %-10.4g gate %-8.4g %s\n", key.c_str(),
+                  m.value, m.reference, m.error, m.gate, m.passed() ? "ok" : "FAILED");
     std::printf("%s\n", r.passed() ? "passed" : "FAILED");
   }
   return r.passed() ? 0 : 1;

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "render/density_field.h"
 #include "render/particle_view.h"
 #include "sim/error.h"
 #include "sim/json_text.h"
@@ -397,7 +398,7 @@ std::vector<Spec> build_specs() {
               "most any water holds in the first tinted frame")
            .in("g/L")
            .at_least(0)
-           .at_most(1e4)
+           .at_most(kMaxTintReference)
            .optional()},
       read_view_set));
   rows.push_back(row<QualitySet>(

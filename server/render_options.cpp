@@ -112,8 +112,9 @@ RenderOptions render_options(const CliArgs& args, const SceneCamera& camera) {
   }
   if (auto v = args.value("--tint-reference")) {
     const double c = args.number("--tint-reference", 0.0);
-    if (!(c > 0 && c <= 1e4))
-      throw Error("--tint-reference: expected a concentration in (0, 1e4] g/L, got '" + *v + "'");
+    if (!(c > 0 && c <= kMaxTintReference))
+      throw Error("--tint-reference: expected a concentration in (0, " + format_number(kMaxTintReference) +
+                  "] g/L, got '" + *v + "'");
     o.field.tint_reference = static_cast<float>(c);
   }
   if (auto v = args.value("--field-cells")) {
@@ -139,7 +140,8 @@ FieldOptions TintLatch::apply(FieldOptions fields, double time) const {
 }
 
 void TintLatch::remember(const FieldOptions& fields, const DensityFields& built, double time) {
-  if (fields.tint.empty() || !(built.tint_reference > 0)) return;
+  // Only an automatic frame's reference is latched: one given outright is not what "auto" would pick.
+  if (fields.tint.empty() || fields.tint_reference != 0 || !(built.tint_reference > 0)) return;
   if (fields.tint == substance_ && reference_ > 0 && time >= time_) return;
   substance_ = fields.tint;
   reference_ = built.tint_reference;

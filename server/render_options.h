@@ -61,7 +61,7 @@ class TintLatch {
  public:
   // `fields` with the latched reference, when there is one for its substance and `time`.
   FieldOptions apply(FieldOptions fields, double time) const;
-  // Remembers what a frame built with `fields` used.
+  // Remembers what an automatic frame (reference 0) built with `fields` used.
   void remember(const FieldOptions& fields, const DensityFields& built, double time);
 
  private:

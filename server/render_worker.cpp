@@ -166,9 +166,8 @@ bool RenderWorker::render_one(const std::shared_ptr<const RenderSnapshot>& snaps
         uploaded_ = snapshot;
         uploaded_field_options_ = wanted;
         tint_.remember(wanted, *fields, snapshot->time);
-        // The next frame of this snapshot asks for the latched reference: the same fields.
-        if (!wanted.tint.empty() && wanted.tint_reference == 0)
-          uploaded_field_options_.tint_reference = fields->tint_reference;
+        // As the next frame of this snapshot will ask: with the reference just latched, the same fields.
+        uploaded_field_options_ = tint_.apply(wanted, snapshot->time);
       }
       renderer = gl_->context.description();
     } else {
@@ -297,8 +296,9 @@ void RenderWorker::set_view(const std::string& view, std::optional<std::string> 
   if (view != "surface" && view != "particles" && view != "slice")
     throw Error("view: unknown view '" + view + "'; available: surface, particles, slice");
   if (colour_by) check_colouring(*colour_by, "colour_by");
-  if (tint_reference && !(*tint_reference >= 0 && *tint_reference <= 1e4))
-    throw Error("tint_reference: expected a concentration in [0, 1e4] g/L");
+  if (tint_reference && !(*tint_reference >= 0 && *tint_reference <= kMaxTintReference))
+    throw Error("tint_reference: expected a concentration in [0, " + format_number(kMaxTintReference) +
+                "] g/L");
   {
     std::lock_guard lock(mutex_);
     options_.view = view;

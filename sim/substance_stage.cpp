@@ -337,10 +337,10 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
   }
   if (deposit_) {
     const std::size_t cells = std::size_t(nv.grid.nx) * std::size_t(nv.grid.ny) * std::size_t(nv.grid.nz);
-    if (cells != wet_cell_count_) {
+    if (cells != cell_count_) {
       held_cells_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(cells, 1));
       around_cells_ = cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(cells, 1));
-      wet_cell_count_ = cells;
+      cell_count_ = cells;
     }
     set_args(k_cells_, sub_, store_[core_.phase], nv.cell_start, held_cells_, static_cast<cl_uint>(cells),
              params_);

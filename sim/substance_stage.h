@@ -153,9 +153,9 @@ class SubstanceStage {
   std::vector<int> deposited_;
   std::vector<ParticleStore::Field> deposited_fields_;
   cl::Kernel k_wet_, k_cells_, k_around_;
-  cl::Buffer held_cells_,
-      around_cells_;  // a byte per grid cell: what it holds, what the cells around it hold
-  std::size_t wet_cell_count_ = 0;
+  // A byte per grid cell (substance_cells): what it holds, what the cells around it hold.
+  cl::Buffer held_cells_, around_cells_;
+  std::size_t cell_count_ = 0;
   bool lowers_tension_ = false;  // THAW_TENSION_LAW
   ParticleStore::Field ratio_ = 0;
   const cl::Buffer& on_solids(std::size_t s) const;  // substance s's deposit field, or any past the last

@@ -344,14 +344,14 @@ kernel void substance_norm(global const float4* pos, global const float* soa, gl
 #define CELL_CARRIER 1
 #define CELL_STATIC 2
 kernel void substance_cells(global const float* sub, global const uchar* phase, global const uint* cell_start,
-                            global uchar* wet_cells, const uint ncells, const SubstanceParams P) {
+                            global uchar* held_cells, const uint ncells, const SubstanceParams P) {
   const uint c = get_global_id(0);
   if (c >= ncells) return;
   global const float* M = sub + SUB_M * P.stride;
   uchar held = 0;
   for (uint j = cell_start[c]; j < cell_start[c + 1] && held != (CELL_CARRIER | CELL_STATIC); ++j)
     held |= (M[j] > 0.0f ? CELL_CARRIER : 0) | (THAW_IS_STATIC(phase[j]) ? CELL_STATIC : 0);
-  wet_cells[c] = held;
+  held_cells[c] = held;
 }
 
 /* What the cells around `cell` (the 27 the walks visit, wrapped along periodic axes) hold together. */
@@ -363,8 +363,8 @@ uchar cells_around(const Grid g, const int4 cell, global const uchar* held) {
 #ifdef THAW_PERIODIC
         const int c = heat_cell(g, cell, dz, dy, dx);
 #else
-        const int x = cell.x + dx, y = cell.y + dy, z = cell.z + dz;
-        const int c = (x < 0 || x >= g.nx || y < 0 || y >= g.ny || z < 0 || z >= g.nz) ? -1 : (z * g.ny + y) * g.nx + x;
+        const int4 n = cell + (int4)(dx, dy, dz, 0);
+        const int c = any(n.xyz < 0) || any(n.xyz >= (int3)(g.nx, g.ny, g.nz)) ? -1 : (int)grid_key(g, n);
 #endif
         if (c >= 0) all |= held[c];
       }
@@ -498,13 +498,6 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
 #define DEPOSITED(f, wgt, wc, wd, g, s)                                                            \
   ((f) * (wgt) * ((coat[s] * (wc)) * fmax(1.0f - (g) * inv_coat_capacity[s], 0.0f) - (cleanse[s] * (wd)) * (g)))
 
-/* One step: each water particle's amounts change by its pairs' diffusive transfers, plus (THAW_REJECT) what
- * the giving ice around it hands it; giving ice loses what it hands out. With THAW_SURFACE, surface-active
- * substances also move between the surface and the bulk (eq. 10, ADSORBED) and along the surface between
- * surface particles (eq. 11): Cleary & Monaghan's pair term in 2-D on the particles' points on the surface,
- *   dS_i/dt = sum_j 2 D_s a_i a_j (Gamma_i - Gamma_j) (p_ij . grad W2_ij) / (|p_ij|^2 + eta^2),
- * W2 the kernel's 2-D form (the same shape with sigma_2), symmetric in i and j term by term as eq. 11 asks,
- * where sec. 6.2's (a_i V_i + a_j V_j) is not a surface integral's weight. */
 /* substance_diffuse's candidates j..j+THAW_VW: offsets and r2 (PAIR_LANES), which lanes are within the support
  * (`in`), their carried masses mj and r / H (qr). */
 #define DIFFUSE_LANES(j)                                              \
@@ -513,6 +506,13 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
   const floatV mj = vloadV(0, M + (j));                               \
   const floatV qr = sqrt(r2) * inv_H;
 
+/* One step: each water particle's amounts change by its pairs' diffusive transfers, plus (THAW_REJECT) what
+ * the giving ice around it hands it; giving ice loses what it hands out. With THAW_SURFACE, surface-active
+ * substances also move between the surface and the bulk (eq. 10, ADSORBED) and along the surface between
+ * surface particles (eq. 11): Cleary & Monaghan's pair term in 2-D on the particles' points on the surface,
+ *   dS_i/dt = sum_j 2 D_s a_i a_j (Gamma_i - Gamma_j) (p_ij . grad W2_ij) / (|p_ij|^2 + eta^2),
+ * W2 the kernel's 2-D form (the same shape with sigma_2), symmetric in i and j term by term as eq. 11 asks,
+ * where sec. 6.2's (a_i V_i + a_j V_j) is not a surface integral's weight. */
 kernel void substance_diffuse(global const float4* pos, global const float* soa, global const float* sub,
                               global const uint* cell_start, const Grid g, const SubstanceParams P,
                               global float2* q0, global float2* q1, global float2* q2, global float2* q3,

@@ -437,6 +437,13 @@ TEST(TintLatch, KeepsTheFirstFramesReferenceUntilTheSubstanceOrTheRunChanges) {
   FieldOptions given = wanted;
   given.tint_reference = 5.0f;
   EXPECT_EQ(latch.apply(given, 0.8).tint_reference, 5.0f);
+  // A frame drawn at a given reference latches nothing: back to automatic, the automatic one holds.
+  built.tint_reference = 5.0f;
+  latch.remember(given, built, 0.9);
+  EXPECT_EQ(latch.apply(wanted, 1.0).tint_reference, 2.0f);
+  TintLatch fresh;
+  fresh.remember(given, built, 0.9);
+  EXPECT_EQ(fresh.apply(wanted, 1.0).tint_reference, 0.0f);
   FieldOptions none;
   EXPECT_EQ(latch.apply(none, 0.8).tint_reference, 0.0f);
 }
