@@ -27,7 +27,9 @@ constexpr CommandHelp kCommands[] = {
      "                   --every K steps; --state-out FILE, --state-in FILE, --device D, --quiet,\n"
      "                   --no-progress. Prints the stages it built and per-stage timers.\n"},
     {"validate",
-     "  validate CASE    a validation case against its reference: --res R, --set, --json; --list\n"},
+     "  validate CASE    a validation case against its reference: --res R, --set, --json; --list;\n"
+     "                   --all: every case at its default resolution, one table; --twice [--steps N]:\n"
+     "                   two runs (each stopped after N steps) that must leave the same bits\n"},
     {"bench",
      "  bench throughput µs per particle-step per stage, with a hand-written reference loop (--json)\n"
      "  bench accuracy CASE  error against run time over resolutions (--res 10,15,20 --out DIR)\n"

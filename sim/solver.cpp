@@ -14,6 +14,7 @@
 #include "sim/kernels/sph_kernel.h"
 #include "sim/photons.h"
 #include "sim/rigid_ice.h"
+#include "sim/run_digest.h"
 #include "sim/thermal.h"
 
 namespace thaw {
@@ -323,6 +324,7 @@ std::size_t first_capacity(const Scene& scene, std::size_t n, const EmitterStage
 Solver::Solver(ClRuntime& cl, const Scene& scene, const SimState& st)
     : cl_(cl), scene_(scene), k_(derive_constants(scene)), store_(cl) {
   if (EmitterStage::needed(scene_)) emitters_ = std::make_unique<EmitterStage>(scene_);
+  if ((digest_ = RunDigest::active())) digest_number_ = digest_->solver_made();
   build(st, 0);
 }
 
@@ -423,7 +425,16 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   }
 }
 
-Solver::~Solver() = default;
+Solver::~Solver() {
+  // Its last state, for a RunDigest that compares runs by their ends. A device that fails here has already
+  // failed the run: nothing is recorded then.
+  RunDigest* d = digest_ && RunDigest::active() == digest_ ? digest_ : nullptr;
+  if (!d) return;
+  try {
+    d->record(digest_number_, "end", state());
+  } catch (const std::exception&) {
+  }
+}
 
 ParticleBuffers Solver::buffers() const {
   return {store_[f_.position],
@@ -459,6 +470,15 @@ void Solver::timed(Stage s, F&& f) {
   f();
   cl_.queue().finish();
   timers_.add(s, seconds_since(t0));
+  RunDigest* d = digest_ && RunDigest::active() == digest_ ? digest_ : nullptr;
+  if (d && d->detail() == RunDigest::Detail::Stages) d->record(digest_number_, kStageNames[int(s)], state());
+}
+
+void Solver::report(const char* stage) {
+  RunDigest* d = digest_ && RunDigest::active() == digest_ ? digest_ : nullptr;
+  if (!d) return;
+  if (d->detail() != RunDigest::Detail::Ends) d->record(digest_number_, stage, state());
+  if (d->stop_after() && steps_ >= d->stop_after()) throw RunDigest::Stopped{};
 }
 
 void Solver::build_grid(bool intake) {
@@ -754,6 +774,7 @@ void Solver::step() {
   dt_ = dt;
   ++steps_;
   if (emitters_) timed(Stage::Emit, [&] { emit(dt); });
+  report("step");
 }
 
 // Bender & Koschier 2017, Algorithm 1, started at its neighbourhood update: the densities and alpha of
@@ -801,6 +822,7 @@ void Solver::step_dfsph() {
   dt_ = dt;
   ++steps_;
   if (emitters_) timed(Stage::Emit, [&] { emit(dt); });
+  report("step");
 }
 
 void Solver::hold_ice(bool held) {

@@ -97,6 +97,8 @@ class RigidIce;
 struct ParticleBuffers;
 SolverConstants derive_constants(const Scene& scene);
 
+class RunDigest;
+
 class Solver {
  public:
   // Starts from a state: a fresh one from initial_state(), or one read from a state file.
@@ -230,6 +232,8 @@ class Solver {
   double heat_time_step() const;
   template <class F>
   void timed(Stage s, F&& f);
+  // Reports the state to the thread's RunDigest, if one is installed (sim/run_digest.h).
+  void report(const char* stage);
 
   ClRuntime& cl_;
   Scene scene_;
@@ -242,6 +246,10 @@ class Solver {
   double damping_ = 0;
   StageTimers timers_;
   ParticleLayout layout_;
+  // The RunDigest installed when this solver was made (it reports while that one is still installed), and
+  // its number there.
+  RunDigest* digest_ = nullptr;
+  std::uint32_t digest_number_ = 0;
 
   // The step's stages, in step order (see step()); null where the scene does not need one.
   // Per-particle state, one buffer per declared field, reordered with the sort (sim/particle_store.h).

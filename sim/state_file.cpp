@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <type_traits>
@@ -210,6 +211,8 @@ std::optional<std::string> inconsistent_sizes(const HostParticles& p) {
   return problem;
 }
 
+}  // namespace
+
 std::string encode_state(const SimState& s) {
   const HostParticles& p = s.particles;
   std::uint32_t sections = 0;
@@ -288,6 +291,30 @@ std::string encode_state(const SimState& s) {
   w.u64(fnv1a64(w.buffer()));
   return std::move(w.buffer());
 }
+
+void for_each_state_section(const SimState& s,
+                            const std::function<void(const std::string&, std::string_view)>& visit) {
+  const HostParticles& p = s.particles;
+  const auto bytes = [](const auto& array) {
+    return std::string_view(reinterpret_cast<const char*>(array.data()), array.size() * sizeof(array[0]));
+  };
+  std::string header(40, '\0');
+  const std::uint64_t n = p.size();
+  std::memcpy(&header[0], &n, 8);
+  std::memcpy(&header[8], &s.step, 8);
+  std::memcpy(&header[16], &s.time, 8);
+  std::memcpy(&header[24], &s.dt, 8);
+  std::memcpy(&header[32], &s.clamped, 8);
+  visit("header", header);
+  for_each_array(p, [&](const char* name, const auto& array) { visit(name, bytes(array)); });
+  for_each_optional_array(s, [&](const char* name, const auto& array) { visit(name, bytes(array)); });
+  for (const HostColumn& c : p.columns)
+    if (c.spec.saved) visit(c.spec.name, bytes(c.bytes));
+  for_each_global(s,
+                  [&](const char* name, const std::vector<double>& values) { visit(name, bytes(values)); });
+}
+
+namespace {
 
 std::string read_whole_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);

@@ -34,6 +34,7 @@
 // body id) without breaking readers: a reader skips unknown optional sections and refuses unknown
 // required ones, since ignoring those would resume a different simulation.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -70,6 +71,14 @@ struct SimState {
   // then what left through open sides; empty in runs without substances.
   std::vector<double> substances;
 };
+
+// The bytes a state file of `state` holds.
+std::string encode_state(const SimState& state);
+
+// Each section of `state` with the bytes it holds in memory, in the file's order, after a "header" section of
+// the particle count, step, time, dt and clamped count: to tell which part of two states differs.
+void for_each_state_section(const SimState& state,
+                            const std::function<void(const std::string&, std::string_view)>& visit);
 
 // Writes `state` to `path` atomically and durably; throws thaw::Error naming the path and the reason.
 void write_state_file(const std::string& path, const SimState& state);

@@ -1,6 +1,10 @@
 #include "sim/validation/case.h"
 
+#include <cstring>
+
 #include "sim/error.h"
+#include "sim/run_digest.h"
+#include "sim/stage_timers.h"
 
 namespace thaw {
 
@@ -63,6 +67,56 @@ CaseResult run_validation(ClRuntime& cl, const std::string& name, int res,
   r.name = c.name;
   r.res = res > 0 ? res : c.default_res;
   return r;
+}
+
+namespace {
+
+// Both runs under digests of `detail`; where the second parted from the first, or "".
+std::string compare_twice(ClRuntime& cl, const std::string& name, int res,
+                          const std::vector<std::string>& sets, RunDigest::Detail detail, std::uint64_t steps,
+                          CaseResult (&result)[2]) {
+  auto run = [&](CaseResult& r) {
+    try {
+      r = run_validation(cl, name, res, sets);
+    } catch (const RunDigest::Stopped&) {
+      r = CaseResult{};
+    }
+  };
+  const auto t0 = Clock::now();
+  RunDigest first(detail, steps);
+  run(result[0]);
+  RunDigest second(detail, steps);
+  run(result[1]);
+  result[0].wall_s = seconds_since(t0);
+  for (const RunDigest::Entry& e : first.entries()) result[0].steps = std::max(result[0].steps, e.step);
+  std::string difference = first.first_difference(second);
+  const auto& a = result[0].metrics;
+  const auto& b = result[1].metrics;
+  for (std::size_t k = 0; difference.empty() && k < a.size(); ++k)
+    if (k >= b.size() || std::memcmp(&a[k].second.value, &b[k].second.value, sizeof(double)) != 0)
+      difference = "the metric " + a[k].first + " differs";
+  return difference;
+}
+
+}  // namespace
+
+Repeated run_validation_twice(ClRuntime& cl, const std::string& name, int res,
+                              const std::vector<std::string>& overrides, std::uint64_t steps) {
+  // The solvers' last states first (cheap); where they differ, again with every stage's, to say where.
+  CaseResult r[2];
+  Repeated out;
+  out.difference = compare_twice(cl, name, res, overrides, RunDigest::Detail::Ends, steps, r);
+  if (!out.difference.empty()) {
+    const std::string where = compare_twice(cl, name, res, overrides, RunDigest::Detail::Stages, steps, r);
+    out.difference = where.empty() ? out.difference +
+                                         "; two more runs, compared stage by stage, agreed: the runs "
+                                         "differ only now and then"
+                                   : where;
+  }
+  out.first = r[0];
+  out.first.name = name;
+  out.first.res = res > 0 ? res : find_case(name).default_res;
+  return out;
 }
 
 }  // namespace thaw

@@ -43,6 +43,17 @@ const ValidationCase& find_case(const std::string& name);  // throws Error listi
 CaseResult run_validation(ClRuntime& cl, const std::string& name, int res,
                           const std::vector<std::string>& overrides);
 
+// A case run twice from the start, each run stopped after `steps` steps of any solver it makes (0: run
+// whole): `first` is the first run's result (without metrics where it stopped; `steps` the most any solver
+// took, `wall_s` both runs'), `difference` where the second run's solver states (sim/run_digest.h) or metrics
+// first differ from the first's, "" where they agree bit for bit.
+struct Repeated {
+  CaseResult first;
+  std::string difference;
+};
+Repeated run_validation_twice(ClRuntime& cl, const std::string& name, int res,
+                              const std::vector<std::string>& overrides, std::uint64_t steps);
+
 // The parameter document of a case after overrides and defaults.
 Json case_parameters(const ValidationCase& c, const std::vector<std::string>& overrides);
 

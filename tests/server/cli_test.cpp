@@ -131,6 +131,30 @@ TEST(ThawCli, UnknownValidationCaseNamesTheCases) {
   EXPECT_NE(r.err.find("dam-break"), std::string::npos) << describe(r);
 }
 
+// The same run in two processes leaves the same state file, byte for byte (issue 44): wash-the-plate (heat, a
+// dryer, a coating and its cleanser, free ice) and default at twice their spacing. And `validate --twice`
+// runs a case twice in one process and says the two agree.
+TEST(ThawCli, TwoProcessesGiveTheSameBits) {
+  TempDir dir("cli-twice");
+  for (const std::string run :
+       {"run wash-the-plate --steps 80 --set spacing=0.005", "run default --steps 80 --set spacing=0.006"}) {
+    SCOPED_TRACE(run);
+    for (const char* out : {"a.state", "b.state"}) {
+      const auto r = run_thaw(run + " --state-out " + out + " --no-progress --quiet", dir);
+      ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+    }
+    EXPECT_TRUE(testing::read_file_bytes(dir / "a.state") == testing::read_file_bytes(dir / "b.state"));
+  }
+  const auto twice = run_thaw("validate conservation --twice --steps 150", dir);
+  EXPECT_TRUE(twice.exited && twice.exit_code == 0) << describe(twice);
+  EXPECT_NE(twice.out.find("the same"), std::string::npos) << describe(twice);
+  for (const char* bad :
+       {"validate --all conservation", "validate --all --res 4", "validate conservation --steps 9"}) {
+    const auto r = run_thaw(bad, dir);
+    EXPECT_TRUE(r.exited && r.exit_code != 0) << bad << ": " << describe(r);
+  }
+}
+
 // `thaw bench throughput` and `thaw bench accuracy` end to end, at sizes that take seconds: the
 // throughput JSON has a row per size, and the accuracy sweep writes its table and plot.
 TEST(ThawCli, BenchThroughputPrintsARowPerSize) {

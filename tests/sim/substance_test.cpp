@@ -391,10 +391,6 @@ TEST_F(SubstanceTest, ADroppedDoseGoesToTheWaterAroundThePointAndIntoTheBooks) {
   EXPECT_THROW(s.drop_substance(5, 1e-6, at), Error);
 }
 
-TEST_F(SubstanceTest, ConservationCasePassesAtCiResolution) {
-  testing::expect_case_passes(run_validation(cl(), "conservation", 4, {}));
-}
-
 TEST_F(SubstanceTest, BrineMeltingCasePassesAtCiResolution) {
   testing::expect_case_passes(run_validation(cl(), "brine-melting", 3, {}));
 }
