@@ -24,9 +24,9 @@
 namespace thaw::protocol {
 namespace {
 
-constexpr int kMaxIndex = 63;              // dryers, lamps and emitters a client may address
-constexpr std::size_t kMaxIdChars = 256;   // echoed in every reply, so kept short
-constexpr std::size_t kMaxNameChars = 64;  // scene and state names
+constexpr int kMaxIndex = kMaxAddressable - 1;  // dryers, lamps and emitters a client may address
+constexpr std::size_t kMaxIdChars = 256;        // echoed in every reply, so kept short
+constexpr std::size_t kMaxNameChars = 64;       // scene and state names
 constexpr std::size_t kMaxPathChars = 256;
 constexpr std::size_t kMaxTokenChars = 256;
 

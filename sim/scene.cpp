@@ -916,6 +916,42 @@ void check_emitter(const Emitter& e, const Scene& scene, const std::string& path
                                            format_number(scene.spacing) +
                                            " m): a nozzle must be at least one particle wide");
   check_nozzle_inside(e.position, scene, path);
+  // The disc's reach along each axis: its radius times the sine of the angle between the axis and the
+  // direction. A disc past a side lays its particles outside the domain, where the walls clamp them (a 1 m
+  // nozzle in a 3 cm box laid 350,000 particles a step).
+  const Box& d = scene.domain;
+  for (int a = 0; a < 3; ++a) {
+    const double reach = e.radius * std::sqrt(std::max(0.0, 1.0 - e.direction[a] * e.direction[a]));
+    const double room = std::min(e.position[a] - d.min[a], d.max[a] - e.position[a]);
+    if (reach > room * (1.0 + 1e-9) + 1e-12)
+      throw SceneError(path + ".radius",
+                       format_number(e.radius) + " m: the nozzle's disc reaches " + format_number(reach) +
+                           " m along " + std::string(1, char('x' + a)) +
+                           " from its centre, and the domain's side is " + format_number(room) +
+                           " m away; the disc must lie inside the domain");
+  }
+  // Its centre and two rings of eight points across the disc, none inside a solid or ice.
+  const Eigen::Vector3d u = e.direction.unitOrthogonal(), v = e.direction.cross(u);
+  std::vector<Eigen::Vector3d> points{e.position};
+  for (const double r : {0.5 * e.radius, e.radius - 0.5 * scene.spacing})
+    for (int k = 0; k < 8; ++k) {
+      const double phi = k * M_PI / 4;
+      points.push_back(e.position + r * (std::cos(phi) * u + std::sin(phi) * v));
+    }
+  const auto refuse = [&](const std::string& what, std::size_t index) {
+    throw SceneError(path + ".position", "the nozzle's disc lies inside " + join_path(what, index) +
+                                             ": an emitter must pour into open space");
+  };
+  for (std::size_t b = 0; b < scene.ice.size(); ++b)
+    for (const std::uint8_t in : scene.ice[b].shape.contains(points))
+      if (in) refuse("ice", b);
+  for (std::size_t b = 0; b < scene.solids.size(); ++b) {
+    const Solid& s = scene.solids[b];
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const bool in = s.plane ? (points[k] - s.point).dot(s.normal) < 0.0 : s.shape.contains(points[k]);
+      if (in) refuse("solids", b);
+    }
+  }
 }
 
 void check_dryer(const Dryer& d, const Scene& scene, const std::string& path) {
@@ -949,6 +985,10 @@ Eigen::Vector3d unit_direction(const Eigen::Vector3d& v, const std::string& path
 }
 
 double estimated_memory_bytes(double particles) { return 300e6 + 360.0 * particles; }
+
+double particle_limit() {
+  return std::min(kMaxParticles, std::max(0.0, (memory_limit_bytes() - estimated_memory_bytes(0)) / 360.0));
+}
 
 double memory_limit_bytes() {
   if (const char* env = std::getenv("THAW_MEMORY_LIMIT")) {

@@ -372,8 +372,8 @@ Lamp lamp_from_json(const Json& j, const std::string& path);
 // element gives one instead of `speed`.
 Json to_json(const Emitter& e, const std::vector<Material>& materials);
 Emitter emitter_from_json(const Json& j, const std::string& path, const std::vector<Material>& materials);
-// What an emitter needs of the scene: a nozzle at least one spacing wide, inside the domain (SceneError at
-// PATH.radius or PATH.position).
+// What an emitter needs of the scene: a nozzle at least one spacing wide whose whole disc lies inside the
+// domain (SceneError at PATH.radius or PATH.position), and not inside a solid or ice (PATH.position).
 struct Scene;
 void check_emitter(const Emitter& e, const Scene& scene, const std::string& path);
 // What a dryer needs of the scene: a cone dryer, no air particles (they would carry its heat twice); an
@@ -381,6 +381,8 @@ void check_emitter(const Emitter& e, const Scene& scene, const std::string& path
 // at PATH.model, PATH.nozzle_diameter or PATH.position).
 void check_dryer(const Dryer& d, const Scene& scene, const std::string& path);
 inline constexpr int kMaxAirDryers = 64;  // a scene's air dryers at most (their intake flags are bytes)
+// A scene's lamps, dryers and emitters at most, each (the protocol addresses them by an index below this).
+inline constexpr int kMaxAddressable = 64;
 
 // `v` scaled to unit length; `path` names it in the SceneError when it is not a vector of moderate size:
 // zero, or so long or so short that its squared length overflows or underflows a double. The protocol
@@ -397,6 +399,10 @@ double estimated_memory_bytes(double particles);
 // no limit, +inf), else MemAvailable from /proc/meminfo (+inf where that cannot be read). Throws Error on
 // a malformed THAW_MEMORY_LIMIT.
 double memory_limit_bytes();
+
+// The most particles a run may hold: 20 million, or as many as memory_limit_bytes() leaves room for
+// (estimated_memory_bytes), whichever is fewer.
+double particle_limit();
 
 // Layers of particles in the domain walls and sampled solids: domain.wall_layers, or as many as hold water
 // resting on them: one more than the support ratio above 2 spacings (4 at 3), else the ratio rounded up.

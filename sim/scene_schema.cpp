@@ -779,7 +779,8 @@ const Field& scene_schema() {
               },
               "Radiant heaters, as thermal photons traced through the ice and solids (Iwasaki et al. 2010 "
               "sec. 4 and 6): the first ice or solid voxel a photon meets absorbs it.")
-              .def(Json::array()),
+              .def(Json::array())
+              .at_most(kMaxAddressable),
           array_of(
               "dryers",
               {
@@ -826,7 +827,8 @@ const Field& scene_schema() {
               "Hair dryers: without air particles a cone of warm, fast air that heats the exposed surface "
               "inside it (sim/kernels/dryer_model.h has the model); with `air`, a nozzle that blows warm air "
               "particles (model air, sim/emitters.h).")
-              .def(Json::array()),
+              .def(Json::array())
+              .at_most(kMaxAddressable),
           array_of(
               "emitters",
               {
@@ -838,7 +840,9 @@ const Field& scene_schema() {
                   vec3("direction", "Where the fluid leaves the nozzle; need not be unit length")
                       .def({0.0, 0.0, -1.0})
                       .live_in_place(),
-                  number("radius", "Radius of the nozzle; at least one particle spacing")
+                  number("radius",
+                         "Radius of the nozzle; at least one particle spacing, its disc inside the domain "
+                         "and clear of solids and ice")
                       .in("m")
                       .def(0.005)
                       .above(0)
@@ -874,7 +878,8 @@ const Field& scene_schema() {
               "Nozzles that pour fluid (Iwasaki et al. 2010, Fig. 7): layers of particles on the nozzle's "
               "disc leave it along the direction at the exit speed, spaced so that the mass flow is "
               "rho pi radius^2 speed. A tap a client can open and close (`emitter.set`).")
-              .def(Json::array()),
+              .def(Json::array())
+              .at_most(kMaxAddressable),
       });
   return scene;
 }

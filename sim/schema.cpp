@@ -412,6 +412,9 @@ void validate_choice(const Json& v, const Field& f, const std::string& path) {
 void validate_elements(Json& v, const Field& f, const std::string& path) {
   if (f.nonempty && v.empty()) throw SceneError(path, "must not be empty");
   const Field& element = f.fields.front();
+  if (f.kind == FieldKind::Array && f.max && double(v.size()) > f.max->value)
+    throw SceneError(path, "holds " + std::to_string(v.size()) + " entries, more than the " +
+                               format_number(f.max->value) + " a scene may have");
   if (f.kind == FieldKind::Array) {
     for (std::size_t i = 0; i < v.size(); ++i) validate(v[i], element, join_path(path, i));
     return;

@@ -47,7 +47,7 @@ struct Field {
   std::string unit;                   // SI unit, empty for dimensionless
   std::optional<Json> default_value;  // filled in when absent
   bool absent_ok = false;             // may be absent without a default
-  std::optional<Bound> min, max;      // numbers and integers
+  std::optional<Bound> min, max;      // numbers and integers; max: also the most entries of an array
   bool nonempty = false;              // arrays, maps and subsets must have an element
   bool settable = false;              // a connected client may change it while the simulation runs
   bool in_place = false;              // settable, and applied to the running solver without a rebuild

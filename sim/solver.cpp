@@ -315,8 +315,12 @@ std::size_t first_capacity(const Scene& scene, std::size_t n, const EmitterStage
   for (const Emitter& e : scene.emitters) per_second += EmitterStage::particles_per_second(e, scene.spacing);
   for (const Dryer& d : scene.dryers)
     if (d.model == DryerModel::Air) per_second += EmitterStage::particles_per_second(d, scene.spacing);
-  return n + std::max<std::size_t>(1024, static_cast<std::size_t>(std::ceil(per_second))) +
-         emitters->room_sites().size();
+  // A second of pouring, but never past the particles the machine has room for (particle_limit): a tap's
+  // reservation was once allocated whole (9.6 GB for a 1 m nozzle) before the first step. Filling it later
+  // grows the run, or stops it with a message once that limit is reached (emit).
+  const double wanted =
+      double(n) + std::max(1024.0, std::ceil(per_second)) + double(emitters->room_sites().size());
+  return static_cast<std::size_t>(std::max(double(n), std::min(wanted, particle_limit())));
 }
 
 }  // namespace
@@ -540,16 +544,19 @@ void Solver::emit(double dt) {
   if (n_ + in.size() > layout_.capacity) {
     // Out of room: rebuild every stage for half as many again (at least what is needed) from the state,
     // as a resumed run would; a run resumed from a state file written before this point grows here too.
-    const std::size_t grown = std::max(n_ + in.size(), layout_.capacity + layout_.capacity / 2);
+    const std::size_t least = n_ + in.size();
+    const std::size_t grown = static_cast<std::size_t>(
+        std::max(double(least), std::min(double(layout_.capacity + layout_.capacity / 2), particle_limit())));
     const double needed = estimated_memory_bytes(double(grown)), limit = memory_limit_bytes();
-    if (needed > limit) {
+    if (needed > limit || double(grown) > particle_limit()) {
       // Nothing came in: the books and ids stay with the particles there are.
       emitters_->restore(before);
       next_id_ = first_id;
       std::ostringstream os;
       os << "step " << steps_ << " (t = " << time_ << " s): the emitters have filled the run to " << n_
          << " particles, and " << grown << " would need about " << needed / 1e9 << " GB, more than the "
-         << limit / 1e9 << " GB available (THAW_MEMORY_LIMIT); close the tap (emitters[].open), set "
+         << particle_limit() << " particles a run may hold (" << limit / 1e9
+         << " GB available, THAW_MEMORY_LIMIT; 20 million at most); close the tap (emitters[].open), set "
          << "emitters[].stop, or open a side of the domain (domain.open)";
       throw BlowUpError(os.str());
     }
