@@ -122,7 +122,9 @@ Json Service::scene_state() const {
           {"speed", stats ? stats->value("speed", 0.0) : 0.0},
           {"heat_time_scale", scene->heat.time_scale},
           {"tension", name(scene->tension.model)},
-          {"paused", stats ? stats->value("paused", false) : false}};
+          {"paused", stats ? stats->value("paused", false) : false},
+          // Why the run stopped, if it did (a blow-up, a device failure), as the stats carry it.
+          {"error", stats && stats->contains("error") ? (*stats)["error"] : Json(nullptr)}};
 }
 
 Json Service::quality_json() const {
@@ -317,15 +319,22 @@ void Service::on_published() {
       server_->broadcast_text(event.dump());
     }
   }
-  // Stats at most stats_rate a second: a browser needs no more, and they share the socket with frames.
+  // Stats at most stats_rate a second: a browser needs no more, and they share the socket with frames. But a
+  // run that paused or failed says so at once: the publish that carries it is the last one a paused run
+  // makes, and when it came within the rate's interval of the one before, no client ever heard of it.
+  const auto stats = session_.latest_stats();
   {
     std::lock_guard lock(mutex_);
     const double t = now_s();
-    if (last_stats_ >= 0 && t - last_stats_ < 1.0 / options_.stats_rate) return;
+    const bool paused = stats && stats->value("paused", false);
+    const std::string error = stats && stats->contains("error") ? (*stats)["error"].get<std::string>() : "";
+    const bool news = paused != sent_paused_ || error != sent_error_;
+    if (!news && last_stats_ >= 0 && t - last_stats_ < 1.0 / options_.stats_rate) return;
+    if (!stats || !server_) return;
     last_stats_ = t;
+    sent_paused_ = paused;
+    sent_error_ = error;
   }
-  const auto stats = session_.latest_stats();
-  if (!stats || !server_) return;
   Json s = *stats;
   if (const auto f = renderer_.latest_frame()) {
     s["frame"] = f->frame;

@@ -65,6 +65,9 @@ class Service : public WsHandler {
   std::mutex mutex_;  // clients_ and the stats throttle
   std::map<std::uint64_t, Client> clients_;
   double last_stats_ = -1;
+  // What the last stats sent said of the run: paused, and why it stopped ("": it did not fail).
+  bool sent_paused_ = false;
+  std::string sent_error_;
   std::uint64_t generation_ = 0;  // of the last scene event sent (Session's stats "generation")
   std::uint64_t last_frame_sent_ = 0;
   int subscription_ = 0;

@@ -42,7 +42,8 @@ async def main():
         except thaw_client.CommandError as e:
             print("refused", e.code)
 asyncio.run(main())
-)", 200, &client_status);
+)",
+                                            200, &client_status);
   const bool stopped = served.stop();
   const std::string log = served.log();
 
@@ -99,10 +100,46 @@ asyncio.run(main())
 )",
                                             120, &status);
   EXPECT_EQ(status, 0) << out;
-  for (const char* line : {"welcome default 1 40.0 surface fast 1000.0 False",
-                           "scene event ice-on-plate 0 0 -60.0 35.0 0.0 None", "quality kept full description True",
-                           "reload ice-on-plate full", "reset -60.0 35.0"})
+  for (const char* line :
+       {"welcome default 1 40.0 surface fast 1000.0 False",
+        "scene event ice-on-plate 0 0 -60.0 35.0 0.0 None", "quality kept full description True",
+        "reload ice-on-plate full", "reset -60.0 35.0"})
     EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
+  EXPECT_TRUE(served.stop()) << served.log();
+}
+
+// A run that stops tells every client at once, on every path (issue 44: a blow-up's stats came within the
+// stats rate's interval of the ones before and were dropped, so viewers kept `paused: false, error: null`,
+// and a later client's welcome said paused with no error). The dam break with a speed limit of 0.3 m/s blows
+// up within a few dozen steps, before a client connects and again after its sim.reset.
+TEST(ServeBlowUp, EveryClientHearsThatTheRunStoppedAndWhy) {
+  TempDir dir("serve-blowup");
+  ServedScene served(dir, "dam-break --set spacing=0.04 --set solver.max_speed=0.3");
+  ASSERT_GT(served.port(), 0) << served.log();
+  int status = 0;
+  const std::string out = served.run_python(R"(import asyncio, thaw_client
+URL = f"ws://127.0.0.1:{PORT}/"
+async def main():
+    welcome = None
+    for _ in range(150):  # until the run has blown up (a paused run publishes no stats)
+        async with thaw_client.connect(URL) as probe:
+            welcome = probe.welcome
+        if welcome["error"] is not None:
+            break
+        await asyncio.sleep(0.2)
+    print("welcome", welcome["paused"], "above the limit" in (welcome["error"] or ""))
+    async with thaw_client.connect(URL) as ctl, thaw_client.connect(URL) as viewer:
+        waiter = asyncio.ensure_future(viewer.stats(lambda s: "error" in s, timeout=60))
+        await asyncio.sleep(0)
+        await ctl.command("sim.reset")  # runs again (the blow-up paused it, not a user), and blows up again
+        s = await waiter
+        print("stats", s["paused"], "above the limit" in s["error"])
+asyncio.run(main())
+)",
+                                            120, &status);
+  EXPECT_EQ(status, 0) << out << served.log();
+  EXPECT_NE(out.find("welcome True True"), std::string::npos) << out;
+  EXPECT_NE(out.find("stats True True"), std::string::npos) << out;
   EXPECT_TRUE(served.stop()) << served.log();
 }
 
@@ -112,7 +149,8 @@ TEST(ServeCtl, SendsCommandsAndPrintsTheReplies) {
   ServedScene served(dir, "ice-on-plate --set spacing=0.006 --state-dir states");
   ASSERT_GT(served.port(), 0) << served.log();
   const std::string url = "ws://127.0.0.1:" + std::to_string(served.port()) + "/";
-  const auto ok = testing::run_thaw("ctl " + url + " '{\"type\": \"sim.pause\"}' '{\"type\": \"sim.step\", \"n\": 3}'", dir);
+  const auto ok = testing::run_thaw(
+      "ctl " + url + " '{\"type\": \"sim.pause\"}' '{\"type\": \"sim.step\", \"n\": 3}'", dir);
   ASSERT_TRUE(ok.exited) << ok.err;
   EXPECT_EQ(ok.exit_code, 0) << ok.out << ok.err;
   EXPECT_NE(ok.out.find("\"type\":\"welcome\""), std::string::npos) << ok.out;
@@ -151,7 +189,8 @@ async def main():
         await asyncio.sleep(1.5)
         print("later", (await thaw.command("view.set", view="surface"))["type"])
 asyncio.run(main())
-)", 60, &client_status);
+)",
+                                            60, &client_status);
   EXPECT_TRUE(served.stop()) << served.log();
   EXPECT_EQ(client_status, 0) << out;
   EXPECT_NE(out.find("after acks ack"), std::string::npos) << out;
