@@ -120,6 +120,8 @@ function applyScene(m) {
   applyView(m.view, m.quality);
   applyPace(m.speed, m.heat_time_scale, m.tension);
   applyPaused(m.paused);
+  // A run that stopped publishes no stats: say why now, as the stats would.
+  if (m.error) hud.textContent = `stopped: ${m.error}`;
   history = [];
   pace = [];
   drawPlot();
