@@ -21,6 +21,9 @@
 
 #include "sim/error.h"
 #include "sim/scene.h"
+#include "sim/solver.h"
+#include "sim/substance_stage.h"
+#include "sim/thermal.h"
 
 namespace thaw {
 namespace {
@@ -574,6 +577,127 @@ void write_state_file(const std::string& path, const SimState& state) {
 
 SimState read_state_file(const std::string& path) { return decode_state(path, read_whole_file(path)); }
 
+namespace {
+
+// A state's values against what the scene's physics allows, once each is known to be finite: temperatures
+// above absolute zero, each substance field naming a substance the scene declares (of its kind) with amounts
+// neither negative nor more than the particle's own mass, melt shifts within the law's range, and the
+// books (energy and substances) closing against the particles. A file that passed its checksums yet held
+// -1e300 kg of salt loaded, and its books reported -2.4e39 kg; one whose salt section was renamed loaded
+// with no salt at all.
+void check_state_physics(const SimState& s, const Scene& scene,
+                         const std::function<void(const std::string&)>& refuse) {
+  const HostParticles& p = s.particles;
+  const auto num = format_number;
+  const auto where = [&p](const std::string& section, std::size_t i) {
+    return "section '" + section + "', particle " + std::to_string(i) +
+           (i < p.id.size() ? " (id " + std::to_string(p.id[i]) + ")" : "") + ": ";
+  };
+  const double rest = derive_constants(scene).rest_density;
+  const std::vector<thermal::MaterialThermal> table = material_thermal_table(scene, rest);
+  const auto physical_mass = [&](std::size_t i) {
+    return double(p.position[i][3]) * table[p.material[i]].thermal_mass_scale;
+  };
+
+  // Temperatures: a corrupted enthalpy otherwise ran until a force blew up, and the message blamed the time
+  // step.
+  constexpr double kHottest = 1e4;
+  double enthalpy = 0, enthalpy_scale = 0;
+  for (std::size_t i = 0; i < p.size() && !p.enthalpy.empty(); ++i) {
+    const double h = double(p.enthalpy[i][0]) + double(p.enthalpy[i][1]);
+    const double t = temperature_at(table[p.material[i]], h);
+    if (!(t >= -273.15) || t > kHottest)
+      refuse(where("enthalpy", i) + num(h) + " J/kg is a temperature of " + num(t) +
+             " °C, outside -273.15 to " + num(kHottest) + " °C");
+    enthalpy += physical_mass(i) * h;
+    enthalpy_scale += physical_mass(i) * std::abs(h);
+  }
+
+  // Substance fields: each names one of the scene's substances, of the kind the field is for.
+  std::string declared;
+  for (const Substance& sub : scene.substances) declared += (declared.empty() ? "" : ", ") + sub.name;
+  std::vector<double> total(scene.substances.size(), 0.0);
+  const struct {
+    const char* prefix;
+    const char* what;
+    bool (*fits)(const Substance&);
+  } kinds[] = {
+      {kSubstancePrefix, "dissolved substance", [](const Substance&) { return true; }},
+      {kAdsorbedPrefix, "surface-active substance", [](const Substance& x) { return x.surface_active(); }},
+      {kDepositedPrefix, "coating", [](const Substance& x) { return x.coating(); }}};
+  for (const HostColumn& c : p.columns) {
+    const std::string& name = c.spec.name;
+    if (name == kMeltShiftField) {
+      const float* d = c.as<float>();
+      for (std::size_t i = 0; i < c.size(); ++i)
+        if (!(d[i] >= 0) || d[i] > kMaxMeltingPointDrop * (1 + 1e-6))
+          refuse(where(name, i) + num(d[i]) + " K is not a melt shift from 0 to " +
+                 num(kMaxMeltingPointDrop) + " K");
+      continue;
+    }
+    for (const auto& kind : kinds) {
+      if (name.rfind(kind.prefix, 0) != 0) continue;
+      const std::string sub = name.substr(std::strlen(kind.prefix));
+      std::size_t k = 0;
+      while (k < scene.substances.size() && scene.substances[k].name != sub) ++k;
+      if (k == scene.substances.size() || !kind.fits(scene.substances[k]))
+        refuse("section '" + name + "': the scene declares no " + kind.what + " '" + sub +
+               "' (its substances: " + (declared.empty() ? "none" : declared) + ")");
+      if (c.spec.type != FieldType::Float32 || c.spec.width != 2 || c.size() != p.size())
+        refuse("section '" + name + "': not one pair of floats per particle");
+      const Float2* a = c.as<Float2>();
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const double amount = double(a[i][0]) + double(a[i][1]), mass = physical_mass(i);
+        if (amount < -1e-6 * mass) refuse(where(name, i) + num(amount) + " kg of " + sub + " is negative");
+        if (amount > mass)
+          refuse(where(name, i) + num(amount) + " kg of " + sub + " is more than the particle's own mass, " +
+                 num(mass) + " kg");
+        total[k] += amount;
+      }
+    }
+  }
+  if (!s.substances.empty()) {
+    SubstanceBooks b;
+    try {
+      b = SubstanceBooks::from_vector(s.substances, scene.substances.size());
+    } catch (const Error& e) {
+      refuse(std::string("section 'substances': ") + e.what());
+    }
+    for (std::size_t k = 0; k < scene.substances.size(); ++k) {
+      const std::string& sub = scene.substances[k].name;
+      for (const auto& [value, what] :
+           {std::pair{b.initial[k], "at the start"}, std::pair{b.outflow[k], "gone out"},
+            std::pair{b.inflow[k], "poured in"}})
+        if (value < 0)
+          refuse("section 'substances': " + num(value) + " kg of " + sub + " " + what + " is negative");
+      // The stage conserves to round-off (1e-14 of the totals, docs/SUBSTANCES.md).
+      const double closure = b.closure(k, total[k]), scale = b.initial[k] + b.inflow[k];
+      if (std::abs(closure) > 1e-6 * scale + 1e-30)
+        refuse("section 'substances': " + sub + "'s books do not close against its particles: " +
+               num(total[k]) + " kg held + " + num(b.outflow[k]) + " gone out, against " + num(b.initial[k]) +
+               " at the start + " + num(b.inflow[k]) + " poured in");
+    }
+  }
+  if (!s.energy_budget.empty() && !p.enthalpy.empty()) {
+    EnergyBudget b;
+    try {
+      b = EnergyBudget::from_vector(s.energy_budget);
+    } catch (const Error& e) {
+      refuse(std::string("section 'energy_budget': ") + e.what());
+    }
+    // Runs close to 1e-9 of their heat or less (docs/VALIDATION-RESULTS.md); a thousandth is no round-off.
+    const double gross = std::abs(b.ambient) + std::abs(b.lamps) + std::abs(b.dryers) + std::abs(b.walls) +
+                         std::abs(b.held) + std::abs(b.outflow) + std::abs(b.inflow);
+    const double closure = enthalpy - b.initial - b.heat_in();
+    if (std::abs(closure) > 1e-3 * std::max({enthalpy_scale, gross, 1e-300}))
+      refuse("section 'energy_budget': the books do not close against the particles' enthalpy: " +
+             num(enthalpy) + " J held, against " + num(b.initial) + " J at the start and " +
+             num(b.heat_in()) + " J in since");
+  }
+}
+
+}  // namespace
+
 void check_state(const SimState& s, const Scene& scene, const std::string& origin) {
   const auto refuse = [&origin](const std::string& what) { throw Error(origin + ": " + what); };
   const auto num = format_number;
@@ -643,6 +767,7 @@ void check_state(const SimState& s, const Scene& scene, const std::string& origi
   all_finite(s.outflow, "outflow");
   all_finite(s.inflow, "inflow");
   all_finite(s.substances, "substances");
+  check_state_physics(s, scene, refuse);
 }
 
 }  // namespace thaw

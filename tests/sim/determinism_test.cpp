@@ -98,11 +98,14 @@ Scene coarse_scene(const fs::path& file) {
   return shipped;
 }
 
-// The state after `steps` steps from the start, as a state file's bytes.
+// The state after `steps` steps from the start, as a state file's bytes; what a run leaves passes the checks
+// a state file meets when it is loaded (check_state).
 std::string state_after(ClRuntime& cl, const Scene& scene, int steps) {
   Solver s(cl, scene, initial_state(scene));
   for (int k = 0; k < steps; ++k) s.step();
-  return encode_state(s.state());
+  const SimState state = s.state();
+  EXPECT_NO_THROW(check_state(state, scene, scene.name));
+  return encode_state(state);
 }
 
 // Where two runs of `scene` part, stage by stage (only asked once they have been seen to differ).

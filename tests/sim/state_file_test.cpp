@@ -12,6 +12,9 @@
 #include <type_traits>
 
 #include "sim/error.h"
+#include "sim/solver.h"
+#include "sim/substance_stage.h"
+#include "tests/test_support.h"
 
 namespace thaw {
 namespace {
@@ -451,6 +454,67 @@ TEST(Fnv1a64, KnownVectors) {
   EXPECT_EQ(fnv1a64(""), 0xcbf29ce484222325ull);
   EXPECT_EQ(fnv1a64("a"), 0xaf63dc4c8601ec8cull);
   EXPECT_EQ(fnv1a64("foobar"), 0x85944171f73967e8ull);
+}
+
+}  // namespace
+}  // namespace thaw
+
+namespace thaw {
+namespace {
+
+// What a state holds against the scene's physics (issue 44: -1e300 kg of salt in 40 particles loaded and
+// the books reported -2.4e39 kg; +1e300, the books and the energy budget at 1e300 loaded too; a section
+// renamed from substance_salt to substance_xyzw loaded with no salt; a corrupted enthalpy ran until a
+// force blew up, and the message blamed the time step). Each is refused naming the section and what is
+// wrong; the state as a run leaves it passes.
+class StatePhysics : public testing::ClSuite {};
+
+TEST_F(StatePhysics, SubstancesBooksAndTemperaturesAreCheckedAgainstTheScene) {
+  const Scene scene = load_scene("wash-the-plate", {"spacing=0.005"});
+  Solver solver(cl(), scene, initial_state(scene));
+  for (int k = 0; k < 10; ++k) solver.step();
+  const SimState good = solver.state();
+  EXPECT_NO_THROW(check_state(good, scene, "good"));
+  const auto refused = [&](SimState s, const std::string& says) {
+    try {
+      check_state(s, scene, "bad.state");
+      ADD_FAILURE() << "accepted; expected: " << says;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind("bad.state: ", 0), 0u) << e.what();
+    }
+  };
+  const std::string salt = substance_field(scene.substances[0].name).name;
+  const auto holding = [&](SimState s, const std::string& field, double amount) {
+    HostColumn* c = s.particles.column(field);
+    for (std::size_t i = 0; c && i < s.particles.size(); ++i)
+      if (s.particles.phase[i] == std::uint8_t(Phase::Water)) {
+        c->as<Float2>()[i] = Float2{float(amount), 0.f};
+        break;
+      }
+    return s;
+  };
+  ASSERT_NE(good.particles.column(salt), nullptr) << salt;
+  refused(holding(good, salt, -1e30), "is negative");
+  refused(holding(good, salt, 1e30), "more than the particle's own mass");
+  // A little more salt than the books say: the books do not close.
+  refused(holding(good, salt, 1e-9), "books do not close");
+  SimState renamed = good;
+  renamed.particles.column(salt)->spec.name = "substance_xyzw";
+  refused(renamed, "section 'substance_xyzw': the scene declares no dissolved substance 'xyzw'");
+  SimState books = good;
+  books.substances[0] = -1e300;
+  refused(books, "is negative");
+  books.substances[0] = 1e300;
+  refused(books, "books do not close");
+  SimState budget = good;
+  budget.energy_budget[0] = 1e300;
+  refused(budget, "section 'energy_budget': the books do not close");
+  SimState hot = good;
+  hot.particles.enthalpy[0] = Float2{3e30f, 0.f};
+  refused(hot, "section 'enthalpy', particle 0");
+  hot.particles.enthalpy[0] = Float2{-1e9f, 0.f};
+  refused(hot, "outside -273.15");
 }
 
 }  // namespace
