@@ -24,6 +24,8 @@ struct FieldGrid {
 
 // The most a tint's full-colour concentration may be set to [g/L] (--tint-reference, view.set).
 inline constexpr double kMaxTintReference = 1e4;
+// The least, but for 0 (auto) [g/L]: a microgram a litre, well within a float.
+inline constexpr double kMinTintReference = 1e-6;
 
 struct FieldOptions {
   int max_cells = 128;  // nodes along the longest axis of the particles' bounds (plus margins)

@@ -319,6 +319,11 @@ void read_view_set(ViewSet& c, const Json& v) {
     }
   }
   c.tint_reference = opt<double>(v, "tint_reference");  // its range: the row's schema
+  // Held as a float, where 1e-300 is 0, which means "auto": so was 1e-300 acked and reported back as 0.
+  if (c.tint_reference && *c.tint_reference > 0 && *c.tint_reference < kMinTintReference)
+    throw SceneError("tint_reference", format_number(*c.tint_reference) +
+                                           " g/L is neither 0 (auto) nor at least " +
+                                           format_number(kMinTintReference) + " g/L");
 }
 
 void read_quality_set(QualitySet& c, const Json& v) {
@@ -394,8 +399,8 @@ std::vector<Spec> build_specs() {
             "scene's substances")
            .optional(),
        number("tint_reference",
-              "The surface view coloured by a substance: the concentration of full colour; 0: the "
-              "most any water holds in the first tinted frame")
+              "The surface view coloured by a substance: the concentration of full colour, 0 or at least "
+              "1e-6; 0: the most any water holds in the first tinted frame")
            .in("g/L")
            .at_least(0)
            .at_most(kMaxTintReference)

@@ -112,9 +112,9 @@ RenderOptions render_options(const CliArgs& args, const SceneCamera& camera) {
   }
   if (auto v = args.value("--tint-reference")) {
     const double c = args.number("--tint-reference", 0.0);
-    if (!(c > 0 && c <= kMaxTintReference))
-      throw Error("--tint-reference: expected a concentration in (0, " + format_number(kMaxTintReference) +
-                  "] g/L, got '" + *v + "'");
+    if (!(c >= kMinTintReference && c <= kMaxTintReference))
+      throw Error("--tint-reference: expected a concentration from " + format_number(kMinTintReference) +
+                  " to " + format_number(kMaxTintReference) + " g/L, got '" + *v + "'");
     o.field.tint_reference = static_cast<float>(c);
   }
   if (auto v = args.value("--field-cells")) {

@@ -606,6 +606,8 @@ TEST(ProtocolRefuse, ViewAndQuality) {
       {R"({"type":"view.set","view":"surface","colour_by":3})", "view.set", "colour_by"},
       {R"({"type":"view.set","view":"surface","tint_reference":-1})", "view.set", "tint_reference"},
       {R"({"type":"view.set","view":"surface","tint_reference":"2"})", "view.set", "tint_reference"},
+      // A float holds 1e-300 as 0, "auto": it was acked and reported back as 0 (issue 44).
+      {R"({"type":"view.set","view":"surface","tint_reference":1e-300})", "view.set", "tint_reference"},
       {R"({"type":"quality.set","width":15})", "quality.set", "width"},
       {R"({"type":"quality.set","width":1921})", "quality.set", "width"},
       {R"({"type":"quality.set","width":640.5})", "quality.set", "width"},
