@@ -14,12 +14,15 @@
 namespace thaw {
 namespace {
 
-// The largest error over its gate among a result's metrics (an error above a gate of 0 is infinitely over).
-double worst_over_gate(const CaseResult& r) {
-  double worst = 0;
-  for (const auto& [key, m] : r.metrics)
-    worst = std::max(
-        worst, m.gate > 0 ? m.error / m.gate : (m.error > 0 ? std::numeric_limits<double>::infinity() : 0.0));
+// The metric with the largest error over its gate (an error above a gate of 0 is infinitely over), and that
+// ratio.
+std::pair<std::string, double> worst_over_gate(const CaseResult& r) {
+  std::pair<std::string, double> worst{"", 0.0};
+  for (const auto& [key, m] : r.metrics) {
+    const double over =
+        m.gate > 0 ? m.error / m.gate : (m.error > 0 ? std::numeric_limits<double>::infinity() : 0.0);
+    if (worst.first.empty() || over > worst.second) worst = {key, over};
+  }
   return worst;
 }
 
@@ -61,21 +64,25 @@ Outcome run_case(ClRuntime& cl, const std::string& name, int res, const std::vec
   return o;
 }
 
-void print_table(const std::vector<Outcome>& outcomes, bool twice) {
+void print_header(bool twice) {
   std::printf("%-18s %4s %9s %8s %8s  %-6s %s\n", "case", "res", "particles", "steps", "wall s", "result",
-              twice ? "two runs, bit for bit" : "worst error / gate");
-  for (const Outcome& o : outcomes) {
-    const CaseResult& r = o.result;
-    const std::string particles = r.particles ? std::to_string(r.particles) : "-";
-    std::printf("%-18s %4d %9s %8llu %8.1f  %-6s ", r.name.c_str(), r.res, particles.c_str(),
-                (unsigned long long)r.steps, r.wall_s, o.passed() ? "passed" : "FAILED");
-    if (!o.error.empty())
-      std::printf("%s\n", o.error.c_str());
-    else if (twice)
-      std::printf("%s\n", o.difference.empty() ? "the same" : o.difference.c_str());
-    else
-      std::printf("%.3g\n", worst_over_gate(r));
+              twice ? "two runs, bit for bit" : "worst error / gate (metric)");
+}
+
+void print_row(const Outcome& o, bool twice) {
+  const CaseResult& r = o.result;
+  const std::string particles = r.particles ? std::to_string(r.particles) : "-";
+  std::printf("%-18s %4d %9s %8llu %8.1f  %-6s ", r.name.c_str(), r.res, particles.c_str(),
+              (unsigned long long)r.steps, r.wall_s, o.passed() ? "passed" : "FAILED");
+  if (!o.error.empty()) {
+    std::printf("%s\n", o.error.c_str());
+  } else if (twice) {
+    std::printf("%s\n", o.difference.empty() ? "the same" : o.difference.c_str());
+  } else {
+    const auto [metric, over] = worst_over_gate(r);
+    std::printf("%.3g (%s)\n", over, metric.c_str());
   }
+  std::fflush(stdout);
 }
 
 }  // namespace
@@ -108,15 +115,22 @@ int cmd_validate(int argc, char** argv) {
   if (steps < 0) throw Error("--steps: must be >= 0");
   ClRuntime cl(args.value("--device").value_or(""));
 
+  // The table's rows as the cases finish (an --all run takes a while); with --json, a line each on stderr.
+  const bool json = args.flag("--json"), table = !json && (all || twice);
+  if (table) {
+    std::printf("on %s\n", cl.description().c_str());
+    print_header(twice);
+  }
   std::vector<Outcome> outcomes;
   for (const std::string& name : names) {
     outcomes.push_back(run_case(cl, name, int(res), args.sets(), twice, std::uint64_t(steps)));
-    if (all && !args.flag("--json"))
+    if (table) print_row(outcomes.back(), twice);
+    if (json && all)
       std::fprintf(stderr, "%s: %s\n", name.c_str(), outcomes.back().passed() ? "passed" : "FAILED");
   }
   bool passed = true;
   for (const Outcome& o : outcomes) passed = passed && o.passed();
-  if (args.flag("--json")) {
+  if (json) {
     Json out = Json::array();
     for (const Outcome& o : outcomes) {
       Json j = o.result.to_json();
@@ -124,13 +138,11 @@ int cmd_validate(int argc, char** argv) {
       if (!o.error.empty()) j["error"] = o.error;
       if (twice) j["same_bits"] = o.difference.empty() && o.error.empty();
       if (!o.difference.empty()) j["difference"] = o.difference;
-      if (!twice) j["worst_error_over_gate"] = worst_over_gate(o.result);
+      if (!twice) j["worst_error_over_gate"] = worst_over_gate(o.result).second;
       out.push_back(j);
     }
     std::printf("%s\n", (all ? out : out[0]).dump(2).c_str());
-  } else if (all || twice) {
-    std::printf("on %s\n", cl.description().c_str());
-    print_table(outcomes, twice);
+  } else if (table) {
     std::printf("%s\n", passed ? "passed" : "FAILED");
   } else {
     if (!outcomes[0].error.empty()) throw Error(outcomes[0].error);
