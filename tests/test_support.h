@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -64,6 +65,21 @@ class TempDir {
 
  private:
   fs::path path_;
+};
+
+// Puts an environment variable back as it was (set to its old value, or unset) when it goes out of scope.
+class RestoreEnv {
+ public:
+  explicit RestoreEnv(std::string name) : name_(std::move(name)) {
+    if (const char* v = std::getenv(name_.c_str())) old_ = v;
+  }
+  ~RestoreEnv() { old_ ? ::setenv(name_.c_str(), old_->c_str(), 1) : ::unsetenv(name_.c_str()); }
+  RestoreEnv(const RestoreEnv&) = delete;
+  RestoreEnv& operator=(const RestoreEnv&) = delete;
+
+ private:
+  std::string name_;
+  std::optional<std::string> old_;
 };
 
 inline std::string read_file_bytes(const fs::path& path) {

@@ -266,11 +266,7 @@ TEST_F(EmitterTest, TheFastestJetRunsWithoutLosingAParticle) {
 // A tap left open in a closed tank fills it until the memory runs out: the run stops with an error that
 // says how many particles it has, what more would need and what to do, before allocating anything.
 TEST_F(EmitterTest, ATapThatWouldOutgrowTheMemoryStopsTheRunSayingWhy) {
-  struct Restore {
-    bool had = std::getenv("THAW_MEMORY_LIMIT") != nullptr;
-    std::string old = had ? std::getenv("THAW_MEMORY_LIMIT") : "";
-    ~Restore() { had ? ::setenv("THAW_MEMORY_LIMIT", old.c_str(), 1) : ::unsetenv("THAW_MEMORY_LIMIT"); }
-  } restore;
+  const testing::RestoreEnv restore("THAW_MEMORY_LIMIT");
   const Scene scene =
       tank_scene(R"({"material": "water", "position": [0.03, 0.03, 0.1], "radius": 0.012, "speed": 1})");
   SimState start = initial_state(scene);
@@ -382,11 +378,7 @@ TEST(EmitterScene, ANozzleInsideIceOrASolidAndTooManyAreRefused) {
 // The particles a tap's first second reserves stay within what the machine has room for (issue 44: a 1 m
 // nozzle's reservation took 9.6 GB before the first step); pouring past it stops the run saying why.
 TEST_F(EmitterTest, ATapReservesNoMoreThanTheMachineHoldsBeforeItsFirstStep) {
-  struct Restore {
-    bool had = std::getenv("THAW_MEMORY_LIMIT") != nullptr;
-    std::string old = had ? std::getenv("THAW_MEMORY_LIMIT") : "";
-    ~Restore() { had ? ::setenv("THAW_MEMORY_LIMIT", old.c_str(), 1) : ::unsetenv("THAW_MEMORY_LIMIT"); }
-  } restore;
+  const testing::RestoreEnv restore("THAW_MEMORY_LIMIT");
   // 2.9 cm of radius at 20 m/s: 420,000 particles a second at 5 mm.
   const Scene scene =
       tank_scene(R"({"material": "water", "position": [0.03, 0.03, 0.1], "radius": 0.029, "speed": 20})");

@@ -444,14 +444,7 @@ TEST(SceneError, SpacingAgainstTheDomain) {
 TEST(SceneError, AScenePastTheMachinesMemoryIsRefusedBeforeAllocating) {
   // 18.2 million particles took 6 GB and 24 s for two steps; a scene past the available memory is now
   // refused at load, naming the estimate, the limit and the override.
-  struct Restore {
-    std::string old;
-    bool had;
-    Restore() : had(std::getenv("THAW_MEMORY_LIMIT") != nullptr) {
-      if (had) old = std::getenv("THAW_MEMORY_LIMIT");
-    }
-    ~Restore() { had ? ::setenv("THAW_MEMORY_LIMIT", old.c_str(), 1) : ::unsetenv("THAW_MEMORY_LIMIT"); }
-  } restore;
+  const testing::RestoreEnv restore("THAW_MEMORY_LIMIT");
   ::unsetenv("THAW_MEMORY_LIMIT");
   EXPECT_GT(memory_limit_bytes(), 1e8) << "MemAvailable of this machine";
   // About 2.5 million particles: 300 MB + 360 B each.
