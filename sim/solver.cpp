@@ -432,7 +432,7 @@ void Solver::build(const SimState& st, std::size_t capacity) {
 Solver::~Solver() {
   // Its last state, for a RunDigest that compares runs by their ends. A device that fails here has already
   // failed the run: nothing is recorded then.
-  RunDigest* d = digest_ && RunDigest::active() == digest_ ? digest_ : nullptr;
+  RunDigest* d = listening();
   if (!d) return;
   try {
     d->record(digest_number_, "end", state());
@@ -474,12 +474,14 @@ void Solver::timed(Stage s, F&& f) {
   f();
   cl_.queue().finish();
   timers_.add(s, seconds_since(t0));
-  RunDigest* d = digest_ && RunDigest::active() == digest_ ? digest_ : nullptr;
+  RunDigest* d = listening();
   if (d && d->detail() == RunDigest::Detail::Stages) d->record(digest_number_, kStageNames[int(s)], state());
 }
 
+RunDigest* Solver::listening() const { return digest_ && RunDigest::active() == digest_ ? digest_ : nullptr; }
+
 void Solver::report(const char* stage) {
-  RunDigest* d = digest_ && RunDigest::active() == digest_ ? digest_ : nullptr;
+  RunDigest* d = listening();
   if (!d) return;
   if (d->detail() != RunDigest::Detail::Ends) d->record(digest_number_, stage, state());
   if (d->stop_after() && steps_ >= d->stop_after()) throw RunDigest::Stopped{};

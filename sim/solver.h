@@ -234,6 +234,8 @@ class Solver {
   void timed(Stage s, F&& f);
   // Reports the state to the thread's RunDigest, if one is installed (sim/run_digest.h).
   void report(const char* stage);
+  // The RunDigest this solver reports to: the one installed when it was made, while it still is; else null.
+  RunDigest* listening() const;
 
   ClRuntime& cl_;
   Scene scene_;
