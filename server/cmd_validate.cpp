@@ -56,7 +56,7 @@ Outcome run_case(ClRuntime& cl, const std::string& name, int res, const std::vec
     Repeated r = run_validation_twice(cl, name, res, sets, steps);
     o.result = r.first;
     o.difference = r.difference;
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {  // a blow-up, a refused parameter or a device failure: that case failed
     o.error = e.what();
   }
   o.result.name = name;

@@ -319,7 +319,7 @@ void read_view_set(ViewSet& c, const Json& v) {
     }
   }
   c.tint_reference = opt<double>(v, "tint_reference");  // its range: the row's schema
-  // Held as a float, where 1e-300 is 0, which means "auto": so was 1e-300 acked and reported back as 0.
+  // Held as a float, where anything below about 1e-45 is 0, which means "auto".
   if (c.tint_reference && *c.tint_reference > 0 && *c.tint_reference < kMinTintReference)
     throw SceneError("tint_reference", format_number(*c.tint_reference) +
                                            " g/L is neither 0 (auto) nor at least " +

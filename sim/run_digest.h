@@ -5,7 +5,7 @@
 // thread reports to it: with Detail::Ends its whole state (the state file's bytes) when it is destroyed; with
 // Detail::Steps also after each step; with Detail::Stages after each stage too, each state section on its
 // own. A digest may also stop every run after some steps (a validation case's first few hundred). Nothing is
-// recorded, and a solver pays one thread-local read a stage, when none is installed.
+// recorded, and a solver made while none was installed pays one null-pointer test a stage.
 #include <cstdint>
 #include <string>
 #include <vector>

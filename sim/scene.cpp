@@ -917,8 +917,8 @@ void check_emitter(const Emitter& e, const Scene& scene, const std::string& path
                                            " m): a nozzle must be at least one particle wide");
   check_nozzle_inside(e.position, scene, path);
   // The disc's reach along each axis: its radius times the sine of the angle between the axis and the
-  // direction. A disc past a side lays its particles outside the domain, where the walls clamp them (a 1 m
-  // nozzle in a 3 cm box laid 350,000 particles a step).
+  // direction. A disc past a side lays its particles outside the domain, where the walls clamp them, and a
+  // disc wider than the domain lays more a step than the domain holds.
   const Box& d = scene.domain;
   for (int a = 0; a < 3; ++a) {
     const double reach = e.radius * std::sqrt(std::max(0.0, 1.0 - e.direction[a] * e.direction[a]));

@@ -315,9 +315,9 @@ std::size_t first_capacity(const Scene& scene, std::size_t n, const EmitterStage
   for (const Emitter& e : scene.emitters) per_second += EmitterStage::particles_per_second(e, scene.spacing);
   for (const Dryer& d : scene.dryers)
     if (d.model == DryerModel::Air) per_second += EmitterStage::particles_per_second(d, scene.spacing);
-  // A second of pouring, but never past the particles the machine has room for (particle_limit): a tap's
-  // reservation was once allocated whole (9.6 GB for a 1 m nozzle) before the first step. Filling it later
-  // grows the run, or stops it with a message once that limit is reached (emit).
+  // A second of pouring, but never past the particles the machine has room for (particle_limit), which is
+  // checked before anything is allocated. Filling it later grows the run, or stops it with a message once
+  // that limit is reached (emit).
   const double wanted =
       double(n) + std::max(1024.0, std::ceil(per_second)) + double(emitters->room_sites().size());
   return static_cast<std::size_t>(std::max(double(n), std::min(wanted, particle_limit())));

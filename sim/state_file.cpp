@@ -579,20 +579,22 @@ SimState read_state_file(const std::string& path) { return decode_state(path, re
 
 namespace {
 
+// "section 'NAME', particle I (id N): ", how a refusal names a particle.
+std::string particle_in(const HostParticles& p, const std::string& section, std::size_t i) {
+  return "section '" + section + "', particle " + std::to_string(i) +
+         (i < p.id.size() ? " (id " + std::to_string(p.id[i]) + ")" : "") + ": ";
+}
+
 // A state's values against what the scene's physics allows, once each is known to be finite: temperatures
 // above absolute zero, each substance field naming a substance the scene declares (of its kind) with amounts
 // neither negative nor more than the particle's own mass, melt shifts within the law's range, and the
-// books (energy and substances) closing against the particles. A file that passed its checksums yet held
-// -1e300 kg of salt loaded, and its books reported -2.4e39 kg; one whose salt section was renamed loaded
-// with no salt at all.
+// books (energy and substances) closing against the particles. Checksums prove a file is what was written,
+// not that a kernel can run it (StatePhysics in tests/sim/state_file_test.cpp has what got through before).
 void check_state_physics(const SimState& s, const Scene& scene,
                          const std::function<void(const std::string&)>& refuse) {
   const HostParticles& p = s.particles;
   const auto num = format_number;
-  const auto where = [&p](const std::string& section, std::size_t i) {
-    return "section '" + section + "', particle " + std::to_string(i) +
-           (i < p.id.size() ? " (id " + std::to_string(p.id[i]) + ")" : "") + ": ";
-  };
+  const auto where = [&p](const std::string& section, std::size_t i) { return particle_in(p, section, i); };
   const double rest = derive_constants(scene).rest_density;
   const std::vector<thermal::MaterialThermal> table = material_thermal_table(scene, rest);
   const auto physical_mass = [&](std::size_t i) {
@@ -713,10 +715,7 @@ void check_state(const SimState& s, const Scene& scene, const std::string& origi
   region.max().array() += margin;
 
   const HostParticles& p = s.particles;
-  const auto where = [&p](const char* section, std::size_t i) {
-    return std::string("section '") + section + "', particle " + std::to_string(i) +
-           (i < p.id.size() ? " (id " + std::to_string(p.id[i]) + ")" : "") + ": ";
-  };
+  const auto where = [&p](const std::string& section, std::size_t i) { return particle_in(p, section, i); };
   const auto finite4 = [](const Float4& v, int n) {
     for (int k = 0; k < n; ++k)
       if (!std::isfinite(v[std::size_t(k)])) return false;

@@ -147,9 +147,8 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
   std::vector<std::uint8_t> phase_of;
   auto phases = [&](bool count) {
     const HostParticles p = solver.particles();
-    // By the largest id, not the count: the tap's particles take new ids while the open side removes others,
-    // and indexing by an id past the end wrote beyond the vector (the run was the same bit for bit, yet the
-    // case counted no melting in about one run in ten).
+    // Sized by the largest id, not the count: the tap's particles take new ids while the open side removes
+    // others (docs/ARCHITECTURE.md, Determinism).
     const std::uint32_t top = p.size() ? *std::max_element(p.id.begin(), p.id.end()) : 0;
     if (phase_of.size() <= top) phase_of.resize(std::size_t(top) + 1, 255);
     for (std::size_t i = 0; i < p.size(); ++i) {
