@@ -40,15 +40,23 @@ RenderSnapshot make_snapshot(const HostParticles& p, const std::vector<float>& t
   }
   for (const Substance& sub : scene.substances) {
     std::vector<float> c(p.size(), 0.0f);
+    bool bulk = true;
     for (const std::string& field : {substance_field(sub.name).name, adsorbed_field(sub.name).name}) {
       const HostColumn* col = p.column(field);
+      const bool dissolved = bulk;
+      bulk = false;
       if (!col || col->size() != p.size() || p.material.size() != p.size()) continue;
       const Float2* q = col->as<Float2>();
       for (std::size_t i = 0; i < p.size(); ++i) {
         const double m = p.position[i][3];
         const double rho =
             p.material[i] < scene.materials.size() ? scene.materials[p.material[i]].density : 0.0;
-        if (m > 0 && rho > 0) c[i] += static_cast<float>((double(q[i][0]) + double(q[i][1])) * rho / m);
+        if (!(m > 0 && rho > 0)) continue;
+        double held = (double(q[i][0]) + double(q[i][1])) * rho / m;
+        // Past its solubility a particle holds the rest undissolved (sim/kernels/liquidus.h): the view shows
+        // the saturated solution, never more than water dissolves.
+        if (dissolved && sub.solubility > 0) held = std::min(held, sub.solubility * rho);
+        c[i] += static_cast<float>(held);
       }
     }
     s.substances.push_back({sub.name, std::move(c)});

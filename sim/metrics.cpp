@@ -114,6 +114,11 @@ Json substances_json(const Solver& s) {
                          {"inflow", books.inflow[k]},
                          {"closure", closure},
                          {"closure_relative", scale > 0 ? closure / scale : 0.0}};
+    // Past its solubility a melt leaves the rest undissolved (sim/kernels/liquidus.h); known once a step ran.
+    if (p.split) {
+      out[list[k].name]["undissolved"] = p.undissolved;
+      out[list[k].name]["most_mass_fraction"] = p.most_fraction;
+    }
   }
   return out;
 }

@@ -95,6 +95,9 @@ const char* name(Multiphase m) {
 }
 const char* name(NoSlip n) { return n == NoSlip::Adami2012 ? "adami2012" : "none"; }
 const char* name(DryerModel m) { return m == DryerModel::Air ? "air" : "cone"; }
+const char* name(LiquidusLaw l) {
+  return l == LiquidusLaw::CrcNaCl ? "crc_nacl" : l == LiquidusLaw::Table ? "table" : "blagden";
+}
 
 namespace {
 // A choice the schema has already checked, as its enum.
@@ -362,6 +365,51 @@ void check_start(const Scene& s, int material, double T, const std::string& path
                                "); supercooled fluid is not modelled");
 }
 
+// A substance's liquidus and solubility from its entry `d` at `path`: CRC's NaCl table and solubility (which
+// `solubility` may override), or the scene's own table, checked to rise and to stay a rising curve between
+// its points as liquidus.h interpolates it.
+void liquidus_from_json(Substance& sub, const Json& d, const std::string& path) {
+  sub.liquidus =
+      choice_of<LiquidusLaw>(d["liquidus"], {LiquidusLaw::Blagden, LiquidusLaw::CrcNaCl, LiquidusLaw::Table});
+  sub.solubility = d["solubility"].get<double>();
+  if (sub.liquidus == LiquidusLaw::CrcNaCl) {
+    sub.liquidus_points.assign(kCrcNaCl.begin(), kCrcNaCl.end());
+    if (sub.solubility == 0) sub.solubility = kCrcNaClSolubility;
+  }
+  if (sub.liquidus != LiquidusLaw::Table) return;
+  const std::string at = path + ".liquidus_table";
+  if (!d.contains("liquidus_table") || d["liquidus_table"].empty())
+    throw SceneError(at,
+                     "a table liquidus needs its points: [{\"mass_fraction\": w, \"depression\": K}, ...], "
+                     "the last the eutectic");
+  double w0 = 0, d0 = 0;
+  for (std::size_t p = 0; p < d["liquidus_table"].size(); ++p) {
+    const Json& point = d["liquidus_table"][p];
+    const double w = point["mass_fraction"].get<double>(), dep = point["depression"].get<double>();
+    const std::string here = join_path(at, p);
+    if (!(w > w0) || !(dep > d0))
+      throw SceneError(here, "the points must rise in mass_fraction and in depression (" + format_number(w) +
+                                 ", " + format_number(dep) + " K after " + format_number(w0) + ", " +
+                                 format_number(d0) + " K)");
+    // Between points liquidus.h interpolates the slope d / w linearly in w; the curve it draws must rise.
+    if (p > 0) {
+      const double r0 = d0 / w0, r1 = dep / w;
+      for (int k = 1; k <= 64; ++k) {
+        const double x = w0 + (w - w0) * k / 64.0, xp = w0 + (w - w0) * (k - 1) / 64.0;
+        const double y = x * (r0 + (r1 - r0) * (x - w0) / (w - w0)),
+                     yp = xp * (r0 + (r1 - r0) * (xp - w0) / (w - w0));
+        if (!(y > yp))
+          throw SceneError(here,
+                           "between this point and the one before, the interpolated liquidus falls; add a "
+                           "point between them");
+      }
+    }
+    sub.liquidus_points.push_back({w, dep});
+    w0 = w;
+    d0 = dep;
+  }
+}
+
 // The index in s.substances of the substance called `name`, which a scene names at `path`; a SceneError
 // there, listing what the scene declares, if it declares none of that name.
 std::size_t substance_index(const Scene& s, const std::string& name, const std::string& path) {
@@ -374,12 +422,33 @@ std::size_t substance_index(const Scene& s, const std::string& name, const std::
 }
 
 // The concentration of each of the scene's substances [kg/m^3] that a fluid block or an emitter (`entry`, at
-// `path`) gives in its `substances`; 0 for those it does not name.
-std::vector<double> concentrations_from_json(const Json& entry, const std::string& path, const Scene& s) {
+// `path`) of fluid `material` gives in its `substances`; 0 for those it does not name. A concentration past
+// what the fluid dissolves (the substance's solubility) is refused: a scene starts or pours solutions.
+std::vector<double> concentrations_from_json(const Json& entry, const std::string& path, const Scene& s,
+                                             int material) {
   std::vector<double> out(s.substances.size(), 0.0);
   if (!entry.contains("substances")) return out;
-  for (const auto& [name, value] : entry["substances"].items())
-    out[substance_index(s, name, path + ".substances." + name)] = value["concentration"].get<double>();
+  for (const auto& [name, value] : entry["substances"].items()) {
+    const std::string at = path + ".substances." + name;
+    const std::size_t k = substance_index(s, name, at);
+    out[k] = value["concentration"].get<double>();
+    const double most = most_dissolved(s, material, k);
+    if (out[k] > most * (1 + 1e-12))
+      throw SceneError(at + ".concentration",
+                       format_number(out[k]) + " kg/m^3 is more than '" +
+                           s.materials[static_cast<std::size_t>(material)].name + "' dissolves of '" + name +
+                           "' (its solubility " + format_number(s.substances[k].solubility) +
+                           " kg per kg of solution: " + format_number(most) + " kg/m^3)");
+  }
+  // Whatever their solubility, what a fluid holds is part of its mass.
+  double sum = 0;
+  for (double c : out) sum += c;
+  const Material& fluid = s.materials[static_cast<std::size_t>(material)];
+  if (!(sum < fluid.density))
+    throw SceneError(path + ".substances",
+                     format_number(sum) + " kg/m^3 of substances in all is not less than '" + fluid.name +
+                         "''s own density, " + format_number(fluid.density) +
+                         " kg/m^3: they would be more than the fluid that holds them");
   return out;
 }
 
@@ -394,7 +463,7 @@ FluidBlock fluid_block_from_json(Json& f, const std::string& path, const Scene& 
   block.velocity = vec(f["velocity"]);
   block.temperature = temperature_or(f, s.heat.ambient_temperature);
   check_inside(s.domain, block.box, block.shape.axis_aligned_box() ? path + ".box" : path);
-  block.substances = concentrations_from_json(f, path, s);
+  block.substances = concentrations_from_json(f, path, s, block.material);
   check_start(s, block.material, block.temperature, path + (f.contains("temperature") ? ".temperature" : ""),
               block.substances);
   return block;
@@ -543,6 +612,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     sub.diffusivity = d["diffusivity"].get<double>();
     sub.molar_mass = d["molar_mass"].get<double>();
     sub.dissociation = d["dissociation"].get<double>();
+    liquidus_from_json(sub, d, "substances." + name);
     sub.enters_ice = d["enters_ice"].get<bool>();
     sub.kind = choice_of<SubstanceKind>(
         d["kind"], {SubstanceKind::Bulk, SubstanceKind::SurfaceActive, SubstanceKind::Coating});
@@ -681,7 +751,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     if (!e.contains("temperature")) e["temperature"] = s.heat.ambient_temperature;
     const std::string path = join_path("emitters", i);
     s.emitters.push_back(emitter_from_json(e, path, s.materials));
-    s.emitters.back().substances = concentrations_from_json(e, path, s);
+    s.emitters.back().substances = concentrations_from_json(e, path, s, s.emitters.back().material);
     check_emitter(s.emitters.back(), s, path);
   }
 
@@ -1223,19 +1293,50 @@ Scene load_scene(const std::string& file, const std::vector<std::string>& overri
   return scene_from_json(std::move(doc), overrides, std::filesystem::path(path).parent_path().string());
 }
 
+double Substance::eutectic_depression() const {
+  if (!lowers_melting_point()) return 0.0;
+  return liquidus == LiquidusLaw::Blagden ? kMaxMeltingPointDrop : liquidus_points.back()[1];
+}
+
+std::vector<thermal::Liquidus> liquidus_table(const Scene& s) {
+  std::vector<thermal::Liquidus> out(kMaxSubstances);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    thermal::Liquidus& l = out[k];
+    l = thermal::Liquidus{};
+    l.solubility = 1e30f;
+    if (k >= s.substances.size()) continue;
+    const Substance& sub = s.substances[k];
+    if (sub.solubility > 0) l.solubility = static_cast<float>(sub.solubility);
+    if (!sub.lowers_melting_point()) continue;
+    l.cap = static_cast<float>(sub.eutectic_depression());
+    if (sub.liquidus == LiquidusLaw::Blagden) {
+      l.moles = static_cast<float>(sub.dissociation / sub.molar_mass);
+      continue;
+    }
+    l.points = static_cast<int>(sub.liquidus_points.size());
+    for (std::size_t p = 0; p < sub.liquidus_points.size(); ++p) {
+      l.w[p] = static_cast<float>(sub.liquidus_points[p][0]);
+      l.d[p] = static_cast<float>(sub.liquidus_points[p][1]);
+    }
+  }
+  return out;
+}
+
 double melting_point_drop(const Scene& s, int material, const std::vector<double>& concentrations) {
   const Material& m = s.materials[static_cast<std::size_t>(material)];
   if (m.kind != MaterialKind::Fluid) return 0.0;
-  double dissolved = 0.0, particles = 0.0;  // per kg of solution: kg of substance, mol of particles
-  for (std::size_t k = 0; k < concentrations.size() && k < s.substances.size(); ++k) {
-    const Substance& sub = s.substances[k];
-    const double fraction = concentrations[k] / m.density;
-    dissolved += fraction;
-    if (sub.lowers_melting_point()) particles += sub.dissociation * fraction / sub.molar_mass;
-  }
-  return dissolved < 1.0
-             ? std::min(m.cryoscopic_constant * particles / (1.0 - dissolved), kMaxMeltingPointDrop)
-             : kMaxMeltingPointDrop;
+  // Per kg of solution, wholly liquid: kg of each substance.
+  const std::vector<thermal::Liquidus> table = liquidus_table(s);
+  double q[kMaxSubstances] = {};
+  for (std::size_t k = 0; k < concentrations.size() && k < s.substances.size(); ++k)
+    q[k] = concentrations[k] / m.density;
+  return thermal::liquidus_drop(table.data(), kMaxSubstances, q, 1.0, m.cryoscopic_constant);
+}
+
+double most_dissolved(const Scene& s, int material, std::size_t k) {
+  const double w = s.substances.at(k).solubility;
+  return w > 0 ? w * s.materials[static_cast<std::size_t>(material)].density
+               : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace thaw

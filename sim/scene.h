@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim/geometry/shape.h"
+#include "sim/kernels/liquidus.h"
 #include "sim/schema.h"
 
 namespace thaw {
@@ -67,6 +68,10 @@ const char* name(Multiphase m);      // "hu_adams2006", "domaradzki_martyn"
 const char* name(NoSlip n);          // "none", "adami2012"
 const char* name(DryerModel m);      // "cone", "air"
 const char* name(TensionModel m);    // "none", "akinci2013", "iwasaki2010"
+// A substance's liquidus with water (sim/kernels/liquidus.h): Blagden's dilute law, NaCl's measured table
+// (CRC Handbook) to its eutectic, or the scene's own table.
+enum class LiquidusLaw { Blagden, CrcNaCl, Table };
+const char* name(LiquidusLaw l);  // "blagden", "crc_nacl", "table"
 
 struct Material {
   std::string name;
@@ -129,13 +134,24 @@ struct AirFill {
 struct Substance {
   std::string name;
   double diffusivity = 1e-9;  // D in water [m^2/s]
-  // Lowering the melting point (Blagden's law with van 't Hoff's factor): each mole of it per kg of water
-  // lowers the water's melting point by the fluid's cryoscopic constant times `dissociation`. molar_mass 0:
-  // it does not (a dye).
+  // Its phase diagram with the water (sim/kernels/liquidus.h, docs/SUBSTANCES.md): how far below the water's
+  // melting point a melt holding it at mass fraction w freezes. Blagden: the dilute law, each mole of it per
+  // kg of water lowers the melting point by the fluid's cryoscopic constant times `dissociation` (molar_mass
+  // 0: it lowers nothing, a dye), capped at kMaxMeltingPointDrop; CrcNaCl: NaCl's measured freezing points
+  // to its eutectic (kCrcNaCl); Table: `liquidus_points`, the last the eutectic.
+  LiquidusLaw liquidus = LiquidusLaw::Blagden;
   double molar_mass = 0.0;    // M [kg/mol]
   double dissociation = 1.0;  // van 't Hoff's factor i: ions per formula unit (NaCl 2)
-  bool enters_ice = false;    // false: water that freezes gives it up to the water around it
-  bool lowers_melting_point() const { return molar_mass > 0; }
+  // (w, the depression there [K]) rising in both, from the scene (Table) or kCrcNaCl (CrcNaCl)
+  std::vector<std::array<double, 2>> liquidus_points;
+  // The most a melt dissolves, kg of it per kg of melt; past it the rest stays undissolved with the particle.
+  // 0: unlimited.
+  double solubility = 0.0;
+  bool enters_ice = false;  // false: water that freezes gives it up to the water around it
+  bool lowers_melting_point() const { return liquidus != LiquidusLaw::Blagden || molar_mass > 0; }
+  // The largest depression its melt reaches [K]: its eutectic's T_m - T_e (kMaxMeltingPointDrop by
+  // Blagden's law); 0 where it lowers nothing.
+  double eutectic_depression() const;
   // A surface-active substance (Orthmann et al. 2013 sec. 5-6.2) also sits on the water's free surface, an
   // amount per particle over its surface area (a surface excess Gamma [kg/m^2]), exchanged with the bulk by
   // Langmuir's kinetics, dGamma/dt = k_a c (1 - Gamma / Gamma_max) - k_d Gamma, and diffusing along the
@@ -349,13 +365,26 @@ struct Scene {
   Json source;  // the validated document with every default filled in
 };
 
+// NaCl in water, measured (CRC Handbook of Chemistry and Physics, "Concentrative properties of aqueous
+// solutions"): the freezing-point depression [K] at each mass fraction, the last point the eutectic
+// (-21.1 °C at 23.3 %), and its solubility at 0 °C, 26.3 % (35.7 g per 100 g of water).
+inline constexpr std::array<std::array<double, 2>, 6> kCrcNaCl = {
+    {{0.01, 0.593}, {0.05, 3.05}, {0.10, 6.56}, {0.15, 10.89}, {0.20, 16.46}, {0.233, 21.1}}};
+inline constexpr double kCrcNaClSolubility = 0.263;
+
 // How far below its material's melting point a fluid holding `concentrations` of the scene's substances
-// [kg/m^3] melts [K]: Blagden's law with van 't Hoff's factor, K_f sum_s i_s b_s over the substances with a
-// molar mass (b_s their molality), capped at kMaxMeltingPointDrop; 0 for other materials. The substance
-// stage computes the same per particle (sim/kernels/substance.cl).
+// [kg/m^3] melts [K]: each substance's liquidus at its mass fraction (liquidus.h), Blagden's law over the
+// water for those that follow it, capped at the eutectic; 0 for other materials. The substance stage
+// computes the same per particle (sim/kernels/substance.cl).
 inline constexpr double kMaxMeltingPointDrop =
-    40.0;  // [K]: past NaCl's eutectic the dilute law means nothing
+    40.0;  // [K]: Blagden's law's cap; past NaCl's eutectic the dilute law means nothing
 double melting_point_drop(const Scene& s, int material, const std::vector<double>& concentrations);
+// Each of the scene's substances' phase diagram as the kernels read it (kMaxSubstances entries; those past
+// the scene's substances lower nothing).
+std::vector<thermal::Liquidus> liquidus_table(const Scene& s);
+// The most of substance k that `concentrations` of fluid `material` may hold in solution [kg/m^3]: its
+// solubility times the fluid's density; infinity where unlimited.
+double most_dissolved(const Scene& s, int material, std::size_t k);
 
 // A number as messages show it: the shortest form ("0.004", "1100", "1e-09").
 std::string format_number(double v);

@@ -442,10 +442,10 @@ const Field& scene_schema() {
                       .at_least(0)
                       .at_most(1e-2),
                   number("molar_mass",
-                         "Its molar mass, which makes it lower the melting point of the water it is "
-                         "dissolved in by the fluid's cryoscopic_constant times dissociation times its "
-                         "molality (Blagden's law with van 't Hoff's factor): NaCl 0.05844. 0: it does "
-                         "not (a dye)")
+                         "Its molar mass, which under the blagden liquidus makes it lower the melting point "
+                         "of the water it is dissolved in by the fluid's cryoscopic_constant times "
+                         "dissociation times its molality (Blagden's law with van 't Hoff's factor): NaCl "
+                         "0.05844. 0 with blagden: it does not (a dye)")
                       .in("kg/mol")
                       .def(0.0)
                       .at_least(0)
@@ -456,6 +456,33 @@ const Field& scene_schema() {
                       .def(1.0)
                       .at_least(1)
                       .at_most(10),
+                  choice(
+                      "liquidus", {"blagden", "crc_nacl", "table"},
+                      "How far below the water's melting point a melt holding it freezes, by its mass "
+                      "fraction (docs/SUBSTANCES.md): blagden, the dilute law from molar_mass and "
+                      "dissociation, capped at 40 K (it overestimates NaCl's by 7 % at 10 % and has no "
+                      "eutectic); crc_nacl, NaCl's measured freezing points (CRC Handbook) to its eutectic, "
+                      "-21.1 °C at 23.3 %, below which brine freezes through, with NaCl's solubility "
+                      "26.3 %; table, liquidus_table")
+                      .def("blagden"),
+                  array_of("liquidus_table",
+                           {number("mass_fraction", "kg of it per kg of melt").above(0).below(1),
+                            number("depression", "How far below the water's melting point that melt freezes")
+                                .in("K")
+                                .above(0)
+                                .at_most(200)},
+                           "Measured points of the liquidus, rising; the last is the eutectic, past which no "
+                           "melt stays liquid. Between points the slope depression / mass_fraction is "
+                           "interpolated linearly")
+                      .at_most(THAW_LIQUIDUS_POINTS)
+                      .when("liquidus", "table"),
+                  number("solubility",
+                         "The most a melt dissolves, kg of it per kg of solution (NaCl 0.263); more stays "
+                         "undissolved with the particle that holds it and dissolves as water comes. 0: "
+                         "unlimited, or NaCl's with crc_nacl")
+                      .def(0.0)
+                      .at_least(0)
+                      .below(1),
                   flag("enters_ice",
                        "Whether water that freezes keeps it; false (salt, dye): the freezing water gives "
                        "it up to the water around it")

@@ -1021,7 +1021,7 @@ std::size_t Solver::drop_substance(std::size_t s, double amount, const Eigen::Ve
   const double H = k_.support;
   const bool wendland = scene_.solver.kernel == KernelFunction::WendlandC2;
   std::vector<std::pair<std::size_t, double>> share;
-  double sum = 0, nearest = 9 * H * H;
+  double nearest = 9 * H * H;
   std::size_t closest = n_;
   for (std::size_t i = 0; i < n_; ++i) {
     const auto ph = static_cast<Phase>(phase[i]);
@@ -1034,29 +1034,62 @@ std::size_t Solver::drop_substance(std::size_t s, double amount, const Eigen::Ve
     if (r2 >= H * H) continue;
     const float r = static_cast<float>(std::sqrt(r2));
     const double w = wendland ? sph::wendland_c2_w(r, float(H)) : sph::cubic_spline_w(r, float(H));
-    if (w > 0) {
-      share.push_back({i, w});
-      sum += w;
-    }
+    if (w > 0) share.push_back({i, w});
   }
-  if (share.empty() && closest < n_) {
-    share.push_back({closest, 1.0});
-    sum = 1.0;
-  }
+  if (share.empty() && closest < n_) share.push_back({closest, 1.0});
   if (share.empty()) {
     std::ostringstream os;
     os << "substance.drop: no water or ice within " << 3 * H << " m of the point (" << at.x() << ", "
        << at.y() << ", " << at.z() << ")";
     throw Error(os.str());
   }
-  // Each share added to the particle's (hi, lo) pair; the books take what was added.
+  // Each share added to the particle's (hi, lo) pair; the books take what was added. No particle may hold
+  // more of it than its own mass (as a state file may not): a share past that goes to the others by their
+  // weights, and a dose past what they all take together is refused whole, saying the most they take. What a
+  // particle's melt cannot dissolve stays undissolved with it (sim/kernels/liquidus.h).
   const cl::Buffer& field = store_[substances_->fields()[s]];
+  std::vector<Float2> held(share.size());
+  std::vector<double> room(share.size()), give(share.size(), 0.0);
+  std::vector<std::uint8_t> material(n_);
+  q.enqueueReadBuffer(store_[f_.material], CL_TRUE, 0, n_, material.data());
+  double most = 0;
+  for (std::size_t k = 0; k < share.size(); ++k) {
+    const std::size_t i = share[k].first;
+    q.enqueueReadBuffer(field, CL_TRUE, i * sizeof(Float2), sizeof(Float2), &held[k]);
+    const double mass = double(x[i][3]) * table_.at(material[i]).thermal_mass_scale;
+    room[k] = std::max(mass - (double(held[k][0]) + double(held[k][1])), 0.0);
+    most += room[k];
+  }
+  if (amount > most) {
+    std::ostringstream os;
+    os << "substance.drop: " << amount << " kg of " << scene_.substances[s].name << " is more than the "
+       << share.size() << " particles of water and ice it would land on can hold (at most " << most
+       << " kg here: no particle holds more than its own mass of it)";
+    throw Error(os.str());
+  }
+  // Shares by weight among the particles with room; those that fill drop out and the rest is shared again.
+  double left = amount;
+  for (std::size_t round = 0; round < share.size() && left > 0; ++round) {
+    double weight = 0;
+    for (std::size_t k = 0; k < share.size(); ++k)
+      if (give[k] < room[k]) weight += share[k].second;
+    if (!(weight > 0)) break;
+    double given = 0;
+    for (std::size_t k = 0; k < share.size(); ++k) {
+      if (!(give[k] < room[k])) continue;
+      const double d = std::min(left * share[k].second / weight, room[k] - give[k]);
+      give[k] += d;
+      given += d;
+    }
+    left -= given;
+    if (left <= 1e-12 * amount) break;
+  }
   double added = 0;
-  for (const auto& [i, w] : share) {
-    Float2 v;
-    q.enqueueReadBuffer(field, CL_TRUE, i * sizeof(Float2), sizeof(Float2), &v);
+  for (std::size_t k = 0; k < share.size(); ++k) {
+    const std::size_t i = share[k].first;
+    Float2 v = held[k];
     const double before = double(v[0]) + double(v[1]);
-    const double now = before + amount * w / sum;
+    const double now = before + give[k];
     v[0] = static_cast<float>(now);
     v[1] = static_cast<float>(now - double(v[0]));
     added += (double(v[0]) + double(v[1])) - before;

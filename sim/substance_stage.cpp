@@ -166,7 +166,7 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
     if (scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
   const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h",
-                                 "thermal_law.h", "substance_params.h", "substance.cl"},
+                                 "thermal_law.h", "liquidus.h", "substance_params.h", "substance.cl"},
                                 opts);
   k_state_ = cl::Kernel(program, "substance_state");
   if (ice_pass_) k_ice_ = cl::Kernel(program, "substance_ice");
@@ -201,6 +201,9 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   for (const thermal::MaterialThermal& m : material_thermal_table(scene, k.rest_density))
     law.insert(law.end(), {m.latent, m.c_solid, m.c_liquid, m.thermal_mass_scale});
   law_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, law.size() * 4, law.data());
+  liquidus_table_ = liquidus_table(scene);  // each substance's phase diagram
+  liquidus_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                         liquidus_table_.size() * sizeof(thermal::Liquidus), liquidus_table_.data());
 
   params_.support = k.support;
   params_.eta2 = 0.01f * k.smoothing * k.smoothing;
@@ -209,13 +212,8 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
     if (scene.solver.periodic[static_cast<std::size_t>(a)])
       *period[a] = static_cast<float>(scene.domain.max[a] - scene.domain.min[a]);
   params_.flow = scene.solver.flow ? 1u : 0u;
-  params_.max_shift = static_cast<float>(kMaxMeltingPointDrop);
-  float* moles[4] = {&params_.moles0, &params_.moles1, &params_.moles2, &params_.moles3};
-  for (std::size_t s = 0; s < scene.substances.size(); ++s) {
-    const Substance& sub = scene.substances[s];
-    if (sub.lowers_melting_point()) *moles[s] = static_cast<float>(sub.dissociation / sub.molar_mass);
-    if (!sub.enters_ice) params_.reject |= 1u << s;
-  }
+  for (std::size_t s = 0; s < scene.substances.size(); ++s)
+    if (!scene.substances[s].enters_ice) params_.reject |= 1u << s;
 
   // Explicit diffusion is stable for D dt / h^2 below about 1/6 in 3-D; heat keeps the same margin.
   const double D = diffusivity_.empty() ? 0.0 : *std::max_element(diffusivity_.begin(), diffusivity_.end());
@@ -319,6 +317,8 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
   auto& q = cl_.queue();
   params_.stride = layout_.stride;
   params_.n = static_cast<cl_uint>(layout_.n);
+  split_ = true;
+  split_n_ = layout_.n;
   // Slots past the scene's substances take the first one's buffer: the kernels never touch them. Without
   // the ice pass the kernels never read the enthalpy, nor the shift without THAW_MELT_SHIFT; any buffer
   // fills those arguments.
@@ -327,8 +327,8 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
   const cl::Buffer& area = surface_ ? store_[surface_fields_.area] : sub_;
   const cl::Buffer& normal = surface_ ? store_[surface_fields_.normal] : sub_;
   set_args(k_state_, store_[core_.position], store_[core_.density], enthalpy, store_[core_.phase],
-           store_[core_.material], fluid_, law_, sub_, shift, amount(0), amount(1), amount(2), amount(3),
-           area, normal, on_surface(0), on_surface(1), on_surface(2), on_surface(3), on_solids(0),
+           store_[core_.material], fluid_, law_, liquidus_, sub_, shift, amount(0), amount(1), amount(2),
+           amount(3), area, normal, on_surface(0), on_surface(1), on_surface(2), on_surface(3), on_solids(0),
            on_solids(1), on_solids(2), on_solids(3), params_);
   launch(q, k_state_, layout_.n);
   if (surface_) {
@@ -353,8 +353,8 @@ void SubstanceStage::prepare(const NeighbourView& nv) {
   }
   if (ice_pass_) {
     set_args(k_ice_, store_[core_.position], store_[core_.phase], store_[core_.material], fluid_, law_,
-             enthalpy, nv.soa, sub_, shift, nv.cell_start, nv.grid, amount(0), amount(1), amount(2),
-             amount(3), params_);
+             liquidus_, enthalpy, nv.soa, sub_, shift, nv.cell_start, nv.grid, amount(0), amount(1),
+             amount(2), amount(3), params_);
     launch(q, k_ice_, layout_.n);
   }
 }
@@ -428,6 +428,25 @@ std::vector<SubstanceStage::Parts> SubstanceStage::parts() const {
     out[s].dissolved = sum(fields_[s]);
     if (adsorbed_[s] >= 0) out[s].on_surface = sum(adsorbed_fields_[std::size_t(adsorbed_[s])]);
     if (deposited_[s] >= 0) out[s].on_solids = sum(deposited_fields_[std::size_t(deposited_[s])]);
+  }
+  if (!split_) return out;
+  // Each particle's melt (the M block, the first of sub_: its liquid part's mass; -1 for ice handing its
+  // amount out, which has none) from the last prepare, and the amounts now: what the melt does not dissolve
+  // is undissolved. Particles an emitter added since (past split_n_) hold the solution it pours, which the
+  // scene keeps within solubility.
+  std::vector<float> melt(std::min(n, split_n_));
+  if (!melt.empty()) cl_.queue().enqueueReadBuffer(sub_, CL_TRUE, 0, melt.size() * 4, melt.data());
+  for (std::size_t s = 0; s < fields_.size(); ++s) {
+    cl_.queue().enqueueReadBuffer(store_[fields_[s]], CL_TRUE, 0, n * sizeof(Float2), a.data());
+    Parts& p = out[s];
+    p.split = true;
+    for (std::size_t i = 0; i < melt.size(); ++i) {
+      const double q = double(a[i][0]) + double(a[i][1]), m = std::max(double(melt[i]), 0.0);
+      if (!(q > 0)) continue;
+      const double held = thermal::liquidus_dissolved(&liquidus_table_[s], q, m);
+      p.undissolved += q - held;
+      if (m > 0) p.most_fraction = std::max(p.most_fraction, held / m);
+    }
   }
   return out;
 }

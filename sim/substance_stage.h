@@ -120,8 +120,14 @@ class SubstanceStage {
   // Each substance's total over all particles [kg], summed in double from the device's pairs.
   std::vector<double> totals() const;
   // Where each substance is [kg]: dissolved in the water, on its free surface, stuck to solids and ice.
+  // What it holds of each substance [kg]: in the bulk of the water (`dissolved`, as the books name it), on
+  // the free surface, on solids; and, once a step has split them (`split`), how much of the bulk amount is
+  // undissolved (past the melt's solubility, or held by ice with no melt) and the highest mass fraction any
+  // melt holds.
   struct Parts {
     double dissolved = 0, on_surface = 0, on_solids = 0;
+    bool split = false;
+    double undissolved = 0, most_fraction = 0;
   };
   std::vector<Parts> parts() const;
 
@@ -159,7 +165,11 @@ class SubstanceStage {
   bool lowers_tension_ = false;  // THAW_TENSION_LAW
   ParticleStore::Field ratio_ = 0;
   const cl::Buffer& on_solids(std::size_t s) const;  // substance s's deposit field, or any past the last
-  cl::Buffer sub_, fluid_, law_;
+  cl::Buffer sub_, fluid_, law_, liquidus_;
+  std::vector<thermal::Liquidus> liquidus_table_;
+  bool split_ =
+      false;  // prepare has run: the M and W blocks hold each particle's melt and dissolved fractions
+  std::size_t split_n_ = 0;                       // the particles it ran over
   const cl::Buffer& amount(std::size_t s) const;  // substance s's field, or the first's past the last
 };
 

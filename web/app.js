@@ -431,6 +431,8 @@ function showSubstance() {
   if (b && b.inflow > 0) text += `, ${mass(b.inflow)} added`;
   if (b && b.on_surface > 0) text += `; ${mass(b.on_surface)} on the surface`;
   if (b && b.on_solids > 0) text += `; ${mass(b.on_solids)} on solids and ice`;
+  // Past what the melt dissolves (its solubility), or held by ice with no melt: salt that sits undissolved.
+  if (b && b.undissolved > 1e-6 * b.total) text += `; ${mass(b.undissolved)} undissolved`;
   $('substance-total').textContent = text;
 }
 $('substance').addEventListener('change', showSubstance);

@@ -1,7 +1,8 @@
 /* Substances dissolved in the water (issue 20, docs/SUBSTANCES.md): each water particle holds an amount
  * Q_i [kg] of each of up to four substances (THAW_NSUB), carried with it by the flow; between water
  * particles it diffuses by Fick's law, rho Dw/Dt = div(rho D grad w) for the mass fraction w = Q / m. Built
- * with sph_kernel.h, grid_common.h, sph_lanes.h, wrapped_walk.h, thermal_law.h and substance_params.h.
+ * with sph_kernel.h, grid_common.h, sph_lanes.h, wrapped_walk.h, thermal_law.h, liquidus.h and
+ * substance_params.h.
  *
  * The pair term is Cleary & Monaghan's (1999, eq. 9; Brookshaw 1985), the form the heat pass conducts by
  * (heat.cl) and Orthmann et al. 2013 sec. 5 carry their bulk quantities with, with w in place of T and
@@ -18,7 +19,7 @@
  * Water that freezes (THAW_REJECT) gives up the substances that do not enter ice (their enters_ice false) to the
  * water within its support, each water particle j taking the share W_ij / sum_k W_ik; the ice keeps only the
  * round-off of that split. Substances with a molar mass (THAW_MELT_SHIFT) lower the melting point of the water
- * that holds them by K_f sum_s i_s b_s (Blagden's law with van 't Hoff's factor; b_s the molality), and ice
+ * that holds them by their liquidus (liquidus.h: a measured table to the eutectic, or Blagden's dilute law), and ice
  * melts at the lowered point of the water around it (substance_ice): the heat pass reads the shift
  * (heat.cl, thermal_law.h).
  *
@@ -163,37 +164,35 @@ void add_lanes(global float2* q, const uint i, floatV hi, floatV lo) {
   }
 
 /* The melt shift d [K] that the solutes in a particle's melted part give it, consistent with that part:
- * d = K_f n / (f(h, d) m - Q), with f the lowered law's liquid fraction at the particle's enthalpy h
- * (thermal_law.h), Kn = K_f n (n the moles of dissolved particles), Q the kg dissolved and m the physical
- * mass; `l` = (L, c_solid, c_liquid). F(d) = d (f(d) m - Q) - Kn is negative while the melt cannot hold the
- * solutes and rises with d after, so bisection on [0, dmax] finds its one root. Taking f from last step's
- * shift instead swung the shift of brine frozen part-way from step to step (the map's slope is below -1). */
-float own_shift(float h, float4 l, float m, float Q, float Kn, float dmax) {
-  if (Kn <= 0.0f) return 0.0f;
-  if (l.x <= 0.0f) return m > Q ? fmin(Kn / (m - Q), dmax) : dmax;
-  float lo = 0.0f, hi = dmax;
-  if (dmax * (thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, dmax) * m - Q) < Kn) return dmax;
+ * d = D(q, f(h, d) m), with f the lowered law's liquid fraction at the particle's enthalpy h (thermal_law.h),
+ * D the liquidus of a melt of that mass holding the amounts q (liquidus.h: each substance dissolved up to its
+ * solubility, capped at the eutectic), m the physical mass and `l` = (L, c_solid, c_liquid). The melt grows
+ * with d and D falls with the melt, so F(d) = D(q, f(d) m) - d falls, and bisection on [0, cap] finds its
+ * one root; at the cap (D still above it there) the particle is at its eutectic, where what is left of its
+ * melt freezes through as it loses heat. Taking f from last step's shift instead swung the shift of brine
+ * frozen part-way from step to step (the map's slope is below -1). */
+float own_shift(float h, float4 l, float m, const float* q, float kf, global const Liquidus* lq) {
+  const float cap = liquidus_drop(lq, THAW_NSUB, q, 0.0f, kf);
+  if (cap <= 0.0f) return 0.0f;
+  if (l.x <= 0.0f) return liquidus_drop(lq, THAW_NSUB, q, m, kf);
+  if (liquidus_drop(lq, THAW_NSUB, q, thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, cap) * m, kf) >= cap)
+    return cap;
+  float lo = 0.0f, hi = cap;
   for (int k = 0; k < 32; ++k) {
     const float d = 0.5f * (lo + hi);
-    if (d * (thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, d) * m - Q) < Kn) lo = d;
+    if (liquidus_drop(lq, THAW_NSUB, q, thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, d) * m, kf) > d) lo = d;
     else hi = d;
   }
   return 0.5f * (lo + hi);
 }
 
-/* What particle i holds: (kg of substances, moles of the particles they make in solution, i / M each). */
-float2 solutes(global const float2* q[4], const uint i, const SubstanceParams P) {
-  const float moles[4] = {P.moles0, P.moles1, P.moles2, P.moles3};
-  float2 held = (float2)(0.0f);
-  for (int s = 0; s < THAW_NSUB; ++s) {
-    const float amount = q[s][i].x + q[s][i].y;
-    held += (float2)(amount, moles[s] * amount);
-  }
-  return held;
+/* What particle i holds of each substance [kg] (its compensated pairs' sums). */
+void held_amounts(global const float2* q[4], const uint i, float* held) {
+  for (int s = 0; s < THAW_NSUB; ++s) held[s] = q[s][i].x + q[s][i].y;
 }
 
-/* M, A and w of every particle. With THAW_MELT_SHIFT, each water particle's melt shift, the molality of its
- * liquid part (own_shift); `fluid` holds each material's rest density and cryoscopic constant. With the ice
+/* M, A and w of every particle. With THAW_MELT_SHIFT, each water particle's melt shift, the liquidus of its
+ * liquid part (own_shift; `liquidus` holds each substance's); `fluid` holds each material's rest density and cryoscopic constant. With the ice
  * pass (THAW_MELT_SHIFT or THAW_REJECT), ice that is partly melted at its lowered melting point carries
  * substances too, in its melted part: M is that part's mass, its liquid fraction (from its enthalpy and last
  * step's shift; `law` holds each material's L, c_solid, c_liquid and physical over SPH mass) times its
@@ -202,8 +201,8 @@ float2 solutes(global const float2* q[4], const uint i, const SubstanceParams P)
  * brine's liquidus. `shift` is the melt_shift field with THAW_MELT_SHIFT, untouched otherwise. */
 kernel void substance_state(global const float4* pos, global const float* density, global const float2* enthalpy,
                             global const uchar* phase, global const uchar* material, global const float2* fluid,
-                            global const float4* law, global float* sub, global float* shift,
-                            global float2* q0, global float2* q1, global float2* q2, global float2* q3,
+                            global const float4* law, global const Liquidus* liquidus, global float* sub,
+                            global float* shift, global float2* q0, global float2* q1, global float2* q2, global float2* q3,
                             global const float* area, global const float4* normal, global float2* s0,
                             global float2* s1, global float2* s2, global float2* s3, global float2* d0,
                             global float2* d1, global float2* d2, global float2* d3, const SubstanceParams P) {
@@ -234,20 +233,20 @@ kernel void substance_state(global const float4* pos, global const float* densit
     if (((P.coating >> s) & 1u) && !boundary) hand_over(dep[s], q[s], i);
 #endif
   global const float2* qc[4] = {q0, q1, q2, q3};
-  const float2 held = solutes(qc, i, P);
-  const float dissolved = held.x, particles = held.y;
+  float held[THAW_NSUB];
+  held_amounts(qc, i, held);
   float carried = water ? m : 0.0f;
 #if defined(THAW_MELT_SHIFT) || defined(THAW_REJECT)
   const float4 l = law[mi];
   const float2 e = enthalpy[i];
   const float h = e.x + e.y;
 #ifdef THAW_MELT_SHIFT
-  /* Partly frozen water carries its solutes in its liquid part alone, and its shift is the molality of that
+  /* Partly frozen water carries its solutes in its liquid part alone, and its shift is the liquidus of that
    * part (own_shift): as it freezes its solutes concentrate, which lowers its melting point and stops the
-   * freezing (brine rejection). Counted over the whole particle, the brine beside partly melted ice froze
-   * part-way at the liquidus of its undiluted start. */
+   * freezing (brine rejection), down to the eutectic. Counted over the whole particle, the brine beside
+   * partly melted ice froze part-way at the liquidus of its undiluted start. */
   if (water) {
-    const float d = own_shift(h, l, m * l.w, dissolved, f.y * particles, P.max_shift);
+    const float d = own_shift(h, l, m * l.w, held, f.y, liquidus);
     shift[i] = d;
     if (l.x > 0.0f) carried = thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, d) * m * l.w;
   }
@@ -267,10 +266,11 @@ kernel void substance_state(global const float4* pos, global const float* densit
   const float rho = water && P.flow ? density[i] : f.x;
   sub[SUB_M * stride + i] = carried;
   sub[SUB_A * stride + i] = carried / sqrt(rho > 0.0f ? rho : f.x);
-  for (int s = 0; s < THAW_NSUB; ++s) {
-    const float2 a = q[s][i];
-    sub[(SUB_W + s) * stride + i] = carried > 0.0f ? (a.x + a.y) / carried : 0.0f;
-  }
+  /* What diffuses is what the melt dissolves; past its solubility the rest stays with the particle, undissolved
+   * (liquidus.h), and dissolves as the melt grows or its brine thins. */
+  for (int s = 0; s < THAW_NSUB; ++s)
+    sub[(SUB_W + s) * stride + i] =
+        carried > 0.0f ? liquidus_dissolved(liquidus + s, held[s], carried) / carried : 0.0f;
 #ifdef THAW_SURFACE
   const int surface = on_surface && carried > 0.0f;
   sub[SUB_AS * stride + i] = surface ? own_area : 0.0f;
@@ -413,8 +413,8 @@ kernel void substance_wet(global const float4* pos, global const uchar* phase, g
  * summed weight of the carriers within its support, for each substance that does not enter ice and that it
  * holds. */
 kernel void substance_ice(global const float4* pos, global const uchar* phase, global const uchar* material,
-                          global const float2* fluid, global const float4* law, global const float2* enthalpy,
-                          global const float* soa,
+                          global const float2* fluid, global const float4* law,
+                          global const Liquidus* liquidus, global const float2* enthalpy, global const float* soa,
                           global float* sub, global float* shift, global const uint* cell_start, const Grid g,
                           global const float2* q0, global const float2* q1, global const float2* q2,
                           global const float2* q3, const SubstanceParams P) {
@@ -447,14 +447,16 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
 #ifdef THAW_MELT_SHIFT
   const float water_weight = lanes_sum(sww);
   const float around = water_weight > 0.0f ? lanes_sum(sd) / water_weight : 0.0f;
-  /* Or its own, where it holds what lowers it (salt dropped on dry ice): the molality of its melted part, the
-   * cap while it has none, so it melts until its melt holds the salt as brine at its own liquidus. `fluid`
-   * gives ice the cryoscopic constant of the water it melts into. */
+  /* Or its own, where it holds what lowers it (salt dropped on dry ice): the liquidus of its melted part, the
+   * eutectic while it has none, so it melts until its melt holds the salt as brine at its own liquidus (ice
+   * and salt, a freezing mixture, cool towards the eutectic). `fluid` gives ice the cryoscopic constant of
+   * the water it melts into. */
   global const float2* qs[4] = {q0, q1, q2, q3};
-  const float2 held = solutes(qs, i, P);
+  float held[THAW_NSUB];
+  held_amounts(qs, i, held);
   const float4 l = law[material[i]];
   const float2 e = enthalpy[i];
-  const float own = own_shift(e.x + e.y, l, pi.w * l.w, held.x, fluid[material[i]].y * held.y, P.max_shift);
+  const float own = own_shift(e.x + e.y, l, pi.w * l.w, held, fluid[material[i]].y, liquidus);
   shift[i] = fmax(around, own);
 #endif
 #ifdef THAW_REJECT

@@ -14,10 +14,6 @@ typedef struct {
   float period_x, period_y, period_z; /* domain length along each periodic axis, 0 elsewhere [m] */
   /* Each substance's 2 D dt [m^2] for a step of dt (the pair term's constant is this times sigma / H^2). */
   float step0, step1, step2, step3;
-  /* Each substance's van 't Hoff factor over its molar mass, i / M [mol/kg]; 0 where it does not lower the
-   * melting point. */
-  float moles0, moles1, moles2, moles3;
-  float max_shift;     /* the melting point is lowered by at most this [K] */
   unsigned int stride; /* length of each structure-of-arrays block */
   unsigned int n;      /* particles */
   unsigned int flow;   /* 1: moving water takes its density from the density pass */
@@ -50,7 +46,7 @@ typedef struct {
 } SubstanceParams;
 
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(SubstanceParams) == 236, "SubstanceParams must match its OpenCL layout");
+static_assert(sizeof(SubstanceParams) == 216, "SubstanceParams must match its OpenCL layout");
 }  // namespace thaw::substance
 #endif
 

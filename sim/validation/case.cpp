@@ -32,12 +32,12 @@ Json CaseResult::to_json() const {
 
 const std::vector<ValidationCase>& validation_cases() {
   static const std::vector<ValidationCase> cases = {
-      hydrostatic_case(),   dam_break_case(),        conduction_case(),    stefan_case(),
-      rigid_spin_case(),    floating_case(),         cavity_case(),        jet_case(),
-      air_sphere_case(),    air_water_case(),        surface_area_case(),  ambient_sphere_case(),
-      laplace_case(),       drop_oscillation_case(), contact_angle_case(), diffusion_bulk_case(),
-      brine_melting_case(), conservation_case(),     adsorption_case(),    surface_diffusion_case(),
-      coating_case(),       cleansing_case(),        marangoni_case()};
+      hydrostatic_case(),       dam_break_case(),        conduction_case(),    stefan_case(),
+      rigid_spin_case(),        floating_case(),         cavity_case(),        jet_case(),
+      air_sphere_case(),        air_water_case(),        surface_area_case(),  ambient_sphere_case(),
+      laplace_case(),           drop_oscillation_case(), contact_angle_case(), diffusion_bulk_case(),
+      brine_melting_case(),     brine_freezing_case(),   conservation_case(),  adsorption_case(),
+      surface_diffusion_case(), coating_case(),          cleansing_case(),     marangoni_case()};
   return cases;
 }
 

@@ -75,6 +75,7 @@ ValidationCase drop_oscillation_case();
 ValidationCase contact_angle_case();
 ValidationCase diffusion_bulk_case();
 ValidationCase brine_melting_case();
+ValidationCase brine_freezing_case();
 ValidationCase conservation_case();
 ValidationCase adsorption_case();
 ValidationCase surface_diffusion_case();

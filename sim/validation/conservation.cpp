@@ -80,7 +80,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
         {"steel",
          {{"kind", "solid"}, {"density", 7800.0}, {"conductivity", 50.0}, {"specific_heat", 500.0}}}}},
       {"substances",
-       {{"salt", {{"diffusivity", 1.5e-9}, {"molar_mass", 0.05844}, {"dissociation", 2.0}}},
+       {{"salt", {{"diffusivity", 1.5e-9}, {"liquidus", "crc_nacl"}}},
         {"dye", {{"diffusivity", 1e-9}}},
         // Filling its capacity within 5 ms at the paint's concentration, and cleansed by the brine at 3.5 /
         // s.

@@ -287,8 +287,9 @@ TEST_F(SubstanceTest, SaltLowersTheMeltingPointOfTheBrineItIsIn) {
   Solver s(cl(), scene, initial_state(scene));
   s.warm_up();
   const double b = (35.0 / 1000.0 / 0.05844) / (1.0 - 35.0 / 1000.0), expected = 1.86 * 2.0 * b;
+  // (to float precision: the host reads the kernels' table, sim/kernels/liquidus.h)
   EXPECT_NEAR(melting_point_drop(scene, scene.fluids[0].material, scene.fluids[0].substances), expected,
-              1e-9);
+              1e-6 * expected);
   const HostParticles p0 = s.particles();
   const std::vector<float> shift0 = s.melt_shifts(), T0 = s.temperatures();
   ASSERT_EQ(shift0.size(), p0.size());
