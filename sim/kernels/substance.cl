@@ -172,13 +172,17 @@ void add_lanes(global float2* q, const uint i, floatV hi, floatV lo) {
  * melt freezes through as it loses heat. Taking f from last step's shift instead swung the shift of brine
  * frozen part-way from step to step (the map's slope is below -1). */
 float own_shift(float h, float4 l, float m, const float* q, float kf, global const Liquidus* lq) {
+  int holds = 0;
+  for (int s = 0; s < THAW_NSUB; ++s) holds |= q[s] > 0.0f;
+  if (!holds) return 0.0f;
   const float cap = liquidus_drop(lq, THAW_NSUB, q, 0.0f, kf);
   if (cap <= 0.0f) return 0.0f;
   if (l.x <= 0.0f) return liquidus_drop(lq, THAW_NSUB, q, m, kf);
   if (liquidus_drop(lq, THAW_NSUB, q, thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, cap) * m, kf) >= cap)
     return cap;
+  /* 24 halvings take [0, cap] to a float's resolution at the cap (2^-24 of it). */
   float lo = 0.0f, hi = cap;
-  for (int k = 0; k < 32; ++k) {
+  for (int k = 0; k < 24; ++k) {
     const float d = 0.5f * (lo + hi);
     if (liquidus_drop(lq, THAW_NSUB, q, thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, d) * m, kf) > d) lo = d;
     else hi = d;
@@ -270,7 +274,7 @@ kernel void substance_state(global const float4* pos, global const float* densit
    * (liquidus.h), and dissolves as the melt grows or its brine thins. */
   for (int s = 0; s < THAW_NSUB; ++s)
     sub[(SUB_W + s) * stride + i] =
-        carried > 0.0f ? liquidus_dissolved(liquidus + s, held[s], carried) / carried : 0.0f;
+        carried > 0.0f && held[s] != 0.0f ? liquidus_dissolved(liquidus + s, held[s], carried) / carried : 0.0f;
 #ifdef THAW_SURFACE
   const int surface = on_surface && carried > 0.0f;
   sub[SUB_AS * stride + i] = surface ? own_area : 0.0f;
