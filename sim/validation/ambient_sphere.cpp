@@ -6,6 +6,7 @@
 // parameters. Metric: the melted mass at the end (taken, plus the liquid fraction of what is left),
 // against it. The exchange's area is heat.exposed_area (`model`), so the case measures how well each area
 // model carries the air's heat. res = particles across R0.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -104,6 +105,11 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
         taken += double(st.particles.position[i][3]) * table[st.particles.material[i]].thermal_mass_scale;
     }
     keep_only(st.particles, keep);
+    // The areas the state carries are the old surface's: held particles keep a state's areas for the whole
+    // run (Solver::update_surface), so the ice the drained water uncovered would never take the air's heat.
+    // Without them the next solver finds the new surface.
+    std::erase_if(st.particles.columns,
+                  [](const HostColumn& c) { return c.spec.name.rfind("surface_", 0) == 0; });
     st.energy_budget.clear();
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -133,8 +139,9 @@ ValidationCase ambient_sphere_case() {
   return {
       "ambient-sphere",
       "An ice sphere at 0 °C melting in air through a fixed h, meltwater drained: melted mass against the "
-      "shrinking-sphere law (gate 3 %); res = particles across R0",
-      10, params, run};
+      "shrinking-sphere law (gate 3 %); res = particles across R0. The melted sphere's rough surface carries "
+      "more area than the smooth one (+4.8 % at res 10), within the gate from res 20 (+2.8 %)",
+      20, params, run};
 }
 
 }  // namespace thaw
