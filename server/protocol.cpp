@@ -436,7 +436,10 @@ std::vector<Spec> build_specs() {
   rows.push_back(row<SubstanceDrop>(
       "substance.drop",
       {text("substance", "A substance the scene declares in `substances`"),
-       number("amount", "The dose, spread over the water and ice within a kernel's reach of the picked point")
+       number(
+           "amount",
+           "The dose, spread over the water and ice within a kernel's reach of the picked point (up to three "
+           "kernels' where they cannot hold it)")
            .in("kg")
            .above(0)
            .at_most(0.01),

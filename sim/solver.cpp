@@ -1016,57 +1016,63 @@ std::size_t Solver::drop_substance(std::size_t s, double amount, const Eigen::Ve
     q.enqueueReadBuffer(store_[f_.position], CL_FALSE, 0, n_ * sizeof(Float4), x.data());
     q.enqueueReadBuffer(store_[f_.phase], CL_TRUE, 0, n_, phase.data());
   }
-  // Shares by the kernel's weight among the water and ice within its support of the point; where none is
-  // that near (the point lies on a thin film's rendered surface, say), the nearest within three supports.
+  // Shares by the kernel's weight among the water and ice within its support of the point. No particle may
+  // hold more of it than its own mass (as a state file may not): where those particles cannot hold the dose
+  // together (the point lies on a thin film, or the dose is a large pinch), it spreads over the water and ice
+  // within twice and then three times the support, by the kernel stretched to that reach; past what even
+  // those hold it is refused whole, saying the most they take. What a particle's melt cannot dissolve stays
+  // undissolved with it (sim/kernels/liquidus.h).
   const double H = k_.support;
   const bool wendland = scene_.solver.kernel == KernelFunction::WendlandC2;
-  std::vector<std::pair<std::size_t, double>> share;
-  double nearest = 9 * H * H;
-  std::size_t closest = n_;
-  for (std::size_t i = 0; i < n_; ++i) {
-    const auto ph = static_cast<Phase>(phase[i]);
-    if ((ph != Phase::Water && ph != Phase::Ice) || !(x[i][3] > 0)) continue;
-    const double r2 = (Eigen::Vector3d(x[i][0], x[i][1], x[i][2]) - at).squaredNorm();
-    if (r2 < nearest) {
-      nearest = r2;
-      closest = i;
-    }
-    if (r2 >= H * H) continue;
-    const float r = static_cast<float>(std::sqrt(r2));
-    const double w = wendland ? sph::wendland_c2_w(r, float(H)) : sph::cubic_spline_w(r, float(H));
-    if (w > 0) share.push_back({i, w});
+  const cl::Buffer& field = store_[substances_->fields()[s]];
+  std::vector<Float2> amounts(n_);
+  std::vector<std::uint8_t> material(n_);
+  if (n_ > 0) {
+    q.enqueueReadBuffer(field, CL_FALSE, 0, n_ * sizeof(Float2), amounts.data());
+    q.enqueueReadBuffer(store_[f_.material], CL_TRUE, 0, n_, material.data());
   }
-  if (share.empty() && closest < n_) share.push_back({closest, 1.0});
-  if (share.empty()) {
+  std::vector<std::pair<std::size_t, double>> share;
+  std::vector<double> room;
+  double most = 0;
+  bool any = false;
+  for (int reach = 1; reach <= 3; ++reach) {
+    const double R = reach * H;
+    share.clear();
+    room.clear();
+    double held_room = 0;
+    for (std::size_t i = 0; i < n_; ++i) {
+      const auto ph = static_cast<Phase>(phase[i]);
+      if ((ph != Phase::Water && ph != Phase::Ice) || !(x[i][3] > 0)) continue;
+      const double r2 = (Eigen::Vector3d(x[i][0], x[i][1], x[i][2]) - at).squaredNorm();
+      if (r2 >= R * R) continue;
+      const float r = static_cast<float>(std::sqrt(r2));
+      const double w = wendland ? sph::wendland_c2_w(r, float(R)) : sph::cubic_spline_w(r, float(R));
+      if (!(w > 0)) continue;
+      const double mass = double(x[i][3]) * table_.at(material[i]).thermal_mass_scale;
+      share.push_back({i, w});
+      room.push_back(std::max(mass - (double(amounts[i][0]) + double(amounts[i][1])), 0.0));
+      held_room += room.back();
+    }
+    any = any || !share.empty();
+    most = std::max(most, held_room);
+    if (!share.empty() && amount <= held_room) break;
+  }
+  if (!any) {
     std::ostringstream os;
     os << "substance.drop: no water or ice within " << 3 * H << " m of the point (" << at.x() << ", "
        << at.y() << ", " << at.z() << ")";
     throw Error(os.str());
   }
-  // Each share added to the particle's (hi, lo) pair; the books take what was added. No particle may hold
-  // more of it than its own mass (as a state file may not): a share past that goes to the others by their
-  // weights, and a dose past what they all take together is refused whole, saying the most they take. What a
-  // particle's melt cannot dissolve stays undissolved with it (sim/kernels/liquidus.h).
-  const cl::Buffer& field = store_[substances_->fields()[s]];
-  std::vector<Float2> held(share.size());
-  std::vector<double> room(share.size()), give(share.size(), 0.0);
-  std::vector<std::uint8_t> material(n_);
-  q.enqueueReadBuffer(store_[f_.material], CL_TRUE, 0, n_, material.data());
-  double most = 0;
-  for (std::size_t k = 0; k < share.size(); ++k) {
-    const std::size_t i = share[k].first;
-    q.enqueueReadBuffer(field, CL_TRUE, i * sizeof(Float2), sizeof(Float2), &held[k]);
-    const double mass = double(x[i][3]) * table_.at(material[i]).thermal_mass_scale;
-    room[k] = std::max(mass - (double(held[k][0]) + double(held[k][1])), 0.0);
-    most += room[k];
-  }
   if (amount > most) {
     std::ostringstream os;
-    os << "substance.drop: " << amount << " kg of " << scene_.substances[s].name << " is more than the "
-       << share.size() << " particles of water and ice it would land on can hold (at most " << most
-       << " kg here: no particle holds more than its own mass of it)";
+    os << "substance.drop: " << amount << " kg of " << scene_.substances[s].name << " is more than the water "
+       << "and ice within " << 3 * H << " m of the point can hold (at most " << most
+       << " kg: no particle holds more than its own mass of it)";
     throw Error(os.str());
   }
+  std::vector<Float2> held(share.size());
+  for (std::size_t k = 0; k < share.size(); ++k) held[k] = amounts[share[k].first];
+  std::vector<double> give(share.size(), 0.0);
   // Shares by weight among the particles with room; those that fill drop out and the rest is shared again.
   double left = amount;
   for (std::size_t round = 0; round < share.size() && left > 0; ++round) {

@@ -160,9 +160,10 @@ TEST_F(PhaseDiagramTest, BrineFreezingCasePassesAtCiResolution) {
 }
 
 // Salt dropped on dry ice at -5 °C, three times what the ice's melt can dissolve: ice and salt make a
-// freezing mixture that cools towards the eutectic, never below it; no melt holds more than NaCl's solubility
-// and the view shows none stronger; the rest is reported undissolved; salt and energy close; a dose more than
-// the particles it lands on can hold is refused, saying how much they take.
+// freezing mixture that cools towards the eutectic, never below it; a dose more than the ice within a
+// kernel's reach can hold spreads farther, no particle holding more than its mass; no melt holds more than
+// NaCl's solubility and the view shows none stronger; the rest is reported undissolved; salt and energy
+// close; a dose more than the particles it lands on can hold is refused, saying how much they take.
 TEST_F(PhaseDiagramTest, SaltOnIceStaysWithinItsPhaseDiagram) {
   const Json doc = Json::parse(R"({
     "name": "salt-on-ice-test", "domain": {"min": [0, 0, 0], "max": [0.008, 0.008, 0.008]}, "spacing": 0.001,
@@ -179,6 +180,30 @@ TEST_F(PhaseDiagramTest, SaltOnIceStaysWithinItsPhaseDiagram) {
   s.warm_up();
   const Eigen::Vector3d at(0.004, 0.004, 0.0075);
   for (int k = 0; k < 3; ++k) s.drop_substance(0, 5e-6, at);
+  // 60 mg is more than the ice within a kernel's reach can hold (0.92 mg a particle): it spreads farther.
+  {
+    auto salt_of = [](const HostParticles& p) {
+      std::vector<double> out;
+      const Float2* q = p.column(substance_field("salt").name)->as<Float2>();
+      for (std::size_t i = 0; i < p.size(); ++i) out.push_back(double(q[i][0]) + double(q[i][1]));
+      return out;
+    };
+    const std::vector<double> before = salt_of(s.particles());
+    s.drop_substance(0, 6e-5, at);
+    const HostParticles p = s.particles();
+    const std::vector<double> after = salt_of(p);
+    double farthest = 0, added = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (after[i] == before[i]) continue;
+      added += after[i] - before[i];
+      farthest = std::max(
+          farthest, (Eigen::Vector3d(p.position[i][0], p.position[i][1], p.position[i][2]) - at).norm());
+      EXPECT_LE(after[i], 0.917e-6 * (1 + 1e-6))
+          << "particle " << p.id[i] << " holds more salt than its mass";
+    }
+    EXPECT_NEAR(added, 6e-5, 1e-15);
+    EXPECT_GT(farthest, s.constants().support) << "the dose stayed within one kernel's reach";
+  }
   EXPECT_THROW(
       {
         try {
