@@ -45,8 +45,8 @@ const Field& solver_schema() {
           flag(
               "divergence_warm_start",
               "dfsph: start each divergence solve from half of the last step's divergence pressure (Bender & "
-              "Koschier 2017's warm start); false starts it from zero, which ran the dam break 14 % faster "
-              "with the same front and floating draft (docs/BENCHMARKS.md)")
+              "Koschier 2017's warm start); false (the default) starts it from zero: fewer iterations in "
+              "flowing water, the same results (docs/BENCHMARKS.md)")
               .def(false),
           choice(
               "boundary_pressure", {"adami2012", "akinci2012"},
@@ -460,8 +460,8 @@ const Field& scene_schema() {
                       "liquidus", {"blagden", "crc_nacl", "table"},
                       "How far below the water's melting point a melt holding it freezes, by its mass "
                       "fraction (docs/SUBSTANCES.md): blagden, the dilute law from molar_mass and "
-                      "dissociation, capped at 40 K (it overestimates NaCl's by 7 % at 10 % and has no "
-                      "eutectic); crc_nacl, NaCl's measured freezing points (CRC Handbook) to its eutectic, "
+                      "dissociation, capped at 40 K, with no eutectic (it overestimates NaCl's freezing "
+                      "point depression); crc_nacl, NaCl's measured freezing points (CRC Handbook) to its eutectic, "
                       "-21.1 °C at 23.3 %, below which brine freezes through, with NaCl's solubility "
                       "26.3 %; table, liquidus_table")
                       .def("blagden"),
