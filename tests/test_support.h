@@ -164,6 +164,23 @@ inline std::string scene_error_path(Json doc) {
   return "(no error)";
 }
 
+// An 8 mm cube of ice at -5 °C on a 1 mm lattice, held in place (flow off), with no gravity and no heat from
+// the air, and one substance "salt" as `salt` declares it: the salted-ice tests' scene.
+inline Json held_ice_cube(const std::string& name, const Json& salt) {
+  Json doc = Json::parse(R"({
+    "domain": {"min": [0, 0, 0], "max": [0.008, 0.008, 0.008]}, "spacing": 0.001,
+    "gravity": [0, 0, 0], "solver": {"flow": false, "max_dt": 1},
+    "ambient": {"heat_transfer_coefficient": 0},
+    "materials": {
+      "water": {"kind": "fluid", "density": 1000, "conductivity": 0.56, "specific_heat": 4217},
+      "ice": {"kind": "ice", "density": 917, "conductivity": 2.22, "specific_heat": 2050, "melts_into": "water"}},
+    "ice": [{"material": "ice", "box": {"min": [0, 0, 0], "max": [0.008, 0.008, 0.008]}, "temperature": -5}]
+  })");
+  doc["name"] = name;
+  doc["substances"]["salt"] = salt;
+  return doc;
+}
+
 // Prints a validation case's metrics and expects every one within its gate, naming any that is not.
 inline void expect_case_passes(const CaseResult& r) {
   for (const auto& [key, m] : r.metrics) {

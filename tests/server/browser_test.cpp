@@ -178,6 +178,9 @@ async def scenario(call, js, until):
         await call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left", clickCount=1)
     print("dropped", bool(await until("substanceBooks.salt && Math.abs(substanceBooks.salt.inflow - 0.001) < 1e-12", 30)))
     print("closed", await js("Math.abs(substanceBooks.salt.closure_relative) < 1e-12"))
+    # 1 g on a few grams of ice at -5 °C: more than its melt dissolves, and the panel says how much is left.
+    print("undissolved", await until("document.getElementById('substance-total').textContent.includes('undissolved')", 20))
+    print("line", await js("document.getElementById('substance-total').textContent"))
     print("menu", await js("[...document.getElementById('colour-by').options].map(o => o.value).join(',')"))
     await js("{ document.getElementById('view-kind').value = 'particles'; document.getElementById('colour-by').value = 'substance:salt'; document.getElementById('colour-by').dispatchEvent(new Event('change')); }")
     print("coloured", bool(await until("document.getElementById('colour-by').value === 'substance:salt' && document.getElementById('message').textContent === ''", 20)))
@@ -186,7 +189,8 @@ async def scenario(call, js, until):
   EXPECT_EQ(status, 0) << out;
   expect_lines(
       out, {"connected True", "panel True", "frames True", "books True", "dropped True", "closed True",
-            "menu phase,temperature,speed,substance:salt,substance:dye", "coloured True", "screenshot True"});
+            "undissolved True", "menu phase,temperature,speed,substance:salt,substance:dye", "coloured True",
+            "screenshot True"});
   std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
   EXPECT_TRUE(served.stop()) << served.log();
 }

@@ -165,17 +165,8 @@ TEST_F(PhaseDiagramTest, BrineFreezingCasePassesAtCiResolution) {
 // NaCl's solubility and the view shows none stronger; the rest is reported undissolved; salt and energy
 // close; a dose more than the particles it lands on can hold is refused, saying how much they take.
 TEST_F(PhaseDiagramTest, SaltOnIceStaysWithinItsPhaseDiagram) {
-  const Json doc = Json::parse(R"({
-    "name": "salt-on-ice-test", "domain": {"min": [0, 0, 0], "max": [0.008, 0.008, 0.008]}, "spacing": 0.001,
-    "gravity": [0, 0, 0], "solver": {"flow": false, "max_dt": 1},
-    "ambient": {"heat_transfer_coefficient": 0},
-    "materials": {
-      "water": {"kind": "fluid", "density": 1000, "conductivity": 0.56, "specific_heat": 4217},
-      "ice": {"kind": "ice", "density": 917, "conductivity": 2.22, "specific_heat": 2050, "melts_into": "water"}},
-    "substances": {"salt": {"diffusivity": 1.5e-7, "liquidus": "crc_nacl"}},
-    "ice": [{"material": "ice", "box": {"min": [0, 0, 0], "max": [0.008, 0.008, 0.008]}, "temperature": -5}]
-  })");
-  const Scene scene = scene_from_json(doc);
+  const Scene scene = scene_from_json(
+      testing::held_ice_cube("salt-on-ice-test", {{"diffusivity", 1.5e-7}, {"liquidus", "crc_nacl"}}));
   Solver s(cl(), scene, initial_state(scene));
   s.warm_up();
   const Eigen::Vector3d at(0.004, 0.004, 0.0075);

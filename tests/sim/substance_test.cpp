@@ -316,17 +316,8 @@ TEST_F(SubstanceTest, SaltLowersTheMeltingPointOfTheBrineItIsIn) {
 // Salt on dry ice at -5 °C: the salted ice melts into brine at its own liquidus, taking the heat from the
 // ice around it, which cools; salt and energy are all accounted for.
 TEST_F(SubstanceTest, SaltOnDryIceMeltsItIntoBrine) {
-  const Json doc = Json::parse(R"({
-    "name": "salted-ice-test", "domain": {"min": [0, 0, 0], "max": [0.008, 0.008, 0.008]}, "spacing": 0.001,
-    "gravity": [0, 0, 0], "solver": {"flow": false, "max_dt": 1},
-    "ambient": {"heat_transfer_coefficient": 0},
-    "materials": {
-      "water": {"kind": "fluid", "density": 1000, "conductivity": 0.56, "specific_heat": 4217},
-      "ice": {"kind": "ice", "density": 917, "conductivity": 2.22, "specific_heat": 2050, "melts_into": "water"}},
-    "substances": {"salt": {"diffusivity": 1.5e-9, "molar_mass": 0.05844, "dissociation": 2}},
-    "ice": [{"material": "ice", "box": {"min": [0, 0, 0], "max": [0.008, 0.008, 0.008]}, "temperature": -5}]
-  })");
-  const Scene scene = scene_from_json(doc);
+  const Scene scene = scene_from_json(testing::held_ice_cube(
+      "salted-ice-test", {{"diffusivity", 1.5e-9}, {"molar_mass", 0.05844}, {"dissociation", 2}}));
   SimState st = initial_state(scene);
   // 10 µg of salt on each particle of the top layer (each is 0.92 mg of ice). Brine at about -7 °C holds 10 %
   // salt, so the layer should melt by about a tenth as it and the block cool there.
