@@ -7,9 +7,9 @@
  *   Blagden's law with van 't Hoff's factor, d = K_f i b, b = (Q / M) / m_water, the dilute law (`moles`
  *   = i / M); or
  *   a table of measured points (w_k, d_k) from (0, 0), its last point the eutectic (w_e, d_e) past which
- *   no melt stays liquid: between points the apparent slope d / w is interpolated linearly in w (it is
- *   nearly linear for NaCl: 59.3 at 1 %, 65.6 at 10 %, 90.6 at 23.3 %, where d itself curves), below the
- *   first point it is the first point's.
+ *   no melt stays liquid: between points the apparent slope d / w is interpolated linearly in w (for NaCl
+ *   it is nearly linear where d itself curves: docs/SUBSTANCES.md), below the first point it is the first
+ *   point's.
  * A melt dissolves each substance up to its solubility w_sat (kg per kg of melt); what exceeds that stays
  * undissolved, a solid amount carried by the particle, and dissolves as water comes (the split is
  * recomputed from the particle's amount and its melt every step). A melt cannot be colder than the

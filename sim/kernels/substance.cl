@@ -19,8 +19,8 @@
  * Water that freezes (THAW_REJECT) gives up the substances that do not enter ice (their enters_ice false) to the
  * water within its support, each water particle j taking the share W_ij / sum_k W_ik; the ice keeps only the
  * round-off of that split. Substances with a molar mass (THAW_MELT_SHIFT) lower the melting point of the water
- * that holds them by their liquidus (liquidus.h: a measured table to the eutectic, or Blagden's dilute law), and ice
- * melts at the lowered point of the water around it (substance_ice): the heat pass reads the shift
+ * that holds them by their liquidus (liquidus.h: a measured table to the eutectic, or Blagden's dilute law),
+ * and ice melts at the lowered point of the water around it (substance_ice): the heat pass reads the shift
  * (heat.cl, thermal_law.h).
  *
  * Conservation to round-off: each pair's transfer for the step, ((a_i a_j) G_ij) ((w_i - w_j) c), with
@@ -172,9 +172,7 @@ void add_lanes(global float2* q, const uint i, floatV hi, floatV lo) {
  * melt freezes through as it loses heat. Taking f from last step's shift instead swung the shift of brine
  * frozen part-way from step to step (the map's slope is below -1). */
 float own_shift(float h, float4 l, float m, const float* q, float kf, global const Liquidus* lq) {
-  int holds = 0;
-  for (int s = 0; s < THAW_NSUB; ++s) holds |= q[s] > 0.0f;
-  if (!holds) return 0.0f;
+  /* a melt of nothing is at the cap of what it holds: 0 where it holds nothing that lowers */
   const float cap = liquidus_drop(lq, THAW_NSUB, q, 0.0f, kf);
   if (cap <= 0.0f) return 0.0f;
   if (l.x <= 0.0f) return liquidus_drop(lq, THAW_NSUB, q, m, kf);
@@ -184,7 +182,8 @@ float own_shift(float h, float4 l, float m, const float* q, float kf, global con
   float lo = 0.0f, hi = cap;
   for (int k = 0; k < 24; ++k) {
     const float d = 0.5f * (lo + hi);
-    if (liquidus_drop(lq, THAW_NSUB, q, thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, d) * m, kf) > d) lo = d;
+    const float melt = thermal_liquid_fraction_lowered(h, l.x, l.y, l.z, d) * m;
+    if (liquidus_drop(lq, THAW_NSUB, q, melt, kf) > d) lo = d;
     else hi = d;
   }
   return 0.5f * (lo + hi);
@@ -196,7 +195,8 @@ void held_amounts(global const float2* q[4], const uint i, float* held) {
 }
 
 /* M, A and w of every particle. With THAW_MELT_SHIFT, each water particle's melt shift, the liquidus of its
- * liquid part (own_shift; `liquidus` holds each substance's); `fluid` holds each material's rest density and cryoscopic constant. With the ice
+ * liquid part (own_shift; `liquidus` holds each substance's); `fluid` holds each material's rest density and
+ * cryoscopic constant. With the ice
  * pass (THAW_MELT_SHIFT or THAW_REJECT), ice that is partly melted at its lowered melting point carries
  * substances too, in its melted part: M is that part's mass, its liquid fraction (from its enthalpy and last
  * step's shift; `law` holds each material's L, c_solid, c_liquid and physical over SPH mass) times its
@@ -206,7 +206,8 @@ void held_amounts(global const float2* q[4], const uint i, float* held) {
 kernel void substance_state(global const float4* pos, global const float* density, global const float2* enthalpy,
                             global const uchar* phase, global const uchar* material, global const float2* fluid,
                             global const float4* law, global const Liquidus* liquidus, global float* sub,
-                            global float* shift, global float2* q0, global float2* q1, global float2* q2, global float2* q3,
+                            global float* shift, global float2* q0, global float2* q1, global float2* q2,
+                            global float2* q3,
                             global const float* area, global const float4* normal, global float2* s0,
                             global float2* s1, global float2* s2, global float2* s3, global float2* d0,
                             global float2* d1, global float2* d2, global float2* d3, const SubstanceParams P) {
@@ -274,7 +275,7 @@ kernel void substance_state(global const float4* pos, global const float* densit
    * (liquidus.h), and dissolves as the melt grows or its brine thins. */
   for (int s = 0; s < THAW_NSUB; ++s)
     sub[(SUB_W + s) * stride + i] =
-        carried > 0.0f && held[s] != 0.0f ? liquidus_dissolved(liquidus + s, held[s], carried) / carried : 0.0f;
+        carried > 0.0f ? liquidus_dissolved(liquidus + s, held[s], carried) / carried : 0.0f;
 #ifdef THAW_SURFACE
   const int surface = on_surface && carried > 0.0f;
   sub[SUB_AS * stride + i] = surface ? own_area : 0.0f;

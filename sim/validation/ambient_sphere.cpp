@@ -140,7 +140,7 @@ ValidationCase ambient_sphere_case() {
       "ambient-sphere",
       "An ice sphere at 0 °C melting in air through a fixed h, meltwater drained: melted mass against the "
       "shrinking-sphere law (gate 3 %); res = particles across R0. The melted sphere's rough surface carries "
-      "more area than the smooth one (+4.8 % at res 10), within the gate from res 20 (+2.8 %)",
+      "more area than the smooth one, within the gate from res 20 (docs/SURFACE.md)",
       20, params, run};
 }
 

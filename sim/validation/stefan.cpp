@@ -157,8 +157,8 @@ ValidationCase stefan_case() {
   return {
       "stefan",
       "melting or freezing slab against Neumann's solution: front within 2 %, energy balance within 0.1 %; "
-      "res = particles across the front. The front error is flat in res (0.71 % at 5, 0.64 % at 14: "
-      "docs/VALIDATION-RESULTS.md), so the default is 5",
+      "res = particles across the front; its error is flat in res (docs/VALIDATION-RESULTS.md), so the "
+      "default is the smallest, 5",
       5, params, run};
 }
 
