@@ -221,6 +221,12 @@ function simRate() {
   return w1 > w0 ? (t1 - t0) / ((w1 - w0) / 1000) : null;
 }
 
+// A temperature to `digits` decimals, without the "-0.0" that rounding a hair below zero gives.
+function celsius(t, digits) {
+  const text = t.toFixed(digits);
+  return Number(text) === 0 ? (0).toFixed(digits) : text;
+}
+
 function onStats(m) {
   applyPaused(m.paused);
   substanceBooks = m.substances || {};
@@ -250,11 +256,11 @@ function onStats(m) {
   ];
   if (m.ice_fraction !== null && m.ice_fraction !== undefined)
     lines.push(`ice ${(1000 * m.ice_mass).toFixed(2)} g (${(100 * m.ice_fraction).toFixed(1)} % of the start)`);
-  if (T) lines.push(`T mean ${T.mean.toFixed(2)} °C, ${T.min.toFixed(1)} to ${T.max.toFixed(1)} °C`);
+  if (T) lines.push(`T mean ${celsius(T.mean, 2)} °C, ${celsius(T.min, 1)} to ${celsius(T.max, 1)} °C`);
   // With air particles, what comes in and goes out is mostly air (a dryer's jet and its intake, the room's
   // air at open sides), not water poured and run out.
   const A = m.air_temperature, air = m.particles.air || 0;
-  if (A) lines.push(`air mean ${A.mean.toFixed(1)} °C, ${A.min.toFixed(1)} to ${A.max.toFixed(1)} °C`);
+  if (A) lines.push(`air mean ${celsius(A.mean, 1)} °C, ${celsius(A.min, 1)} to ${celsius(A.max, 1)} °C`);
   lines.push(`particles ${m.particles.water} water, ${m.particles.ice} ice` + (air ? `, ${air} air` : ''));
   // The books on a line of their own: with the air's count the line outgrew the picture.
   const books = (m.inflow ? `${air ? 'came in' : 'poured'} ${(1000 * m.inflow.mass).toFixed(1)} g   ` : '') +
@@ -424,9 +430,10 @@ function aimAt(e) {
 // how much sits on the water's surface (a detergent) and on solids and ice (a coating), where it can.
 function showSubstance() {
   const b = substanceBooks[$('substance').value];
-  // In g, mg or µg, whichever reads without an exponent.
-  const mass = (kg) => kg >= 1e-3 ? `${(1e3 * kg).toPrecision(3)} g` : kg >= 1e-6 ? `${(1e6 * kg).toPrecision(3)} mg`
-                                                                  : `${(1e9 * kg).toPrecision(3)} µg`;
+  // In g, mg or µg, whichever reads without an exponent once rounded to three digits (0.9999 g is "1.00 g",
+  // not "1.00e+3 mg").
+  const mass = (kg) => kg >= 0.9995e-3 ? `${(1e3 * kg).toPrecision(3)} g`
+                     : kg >= 0.9995e-6 ? `${(1e6 * kg).toPrecision(3)} mg` : `${(1e9 * kg).toPrecision(3)} µg`;
   let text = b ? `${mass(b.total)} held` : '';
   if (b && b.inflow > 0) text += `, ${mass(b.inflow)} added`;
   if (b && b.on_surface > 0) text += `; ${mass(b.on_surface)} on the surface`;

@@ -82,6 +82,14 @@ void expect_lines(const std::string& out, std::initializer_list<const char*> lin
   for (const char* line : lines) EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
 }
 
+// THAW_TEST_SCREENSHOTS=DIR keeps a test's page as DIR/name, to be looked at; without it the page goes with
+// the test's folder.
+void keep_screenshot(const TempDir& dir, const std::string& name) {
+  if (const char* keep = std::getenv("THAW_TEST_SCREENSHOTS"))
+    std::filesystem::copy_file(dir.path() / "browser.png", std::filesystem::path(keep) / name,
+                               std::filesystem::copy_options::overwrite_existing);
+}
+
 TEST(BrowserClient, LoadsStreamsAndAimsADryerInHeadlessChromium) {
   // scripts/debian-packages.txt lists chromium, so scripts/setup installs it: its absence is a broken
   // set-up, not a reason to pass.
@@ -191,7 +199,7 @@ async def scenario(call, js, until):
       out, {"connected True", "panel True", "frames True", "books True", "dropped True", "closed True",
             "undissolved True", "menu phase,temperature,speed,substance:salt,substance:dye", "coloured True",
             "screenshot True"});
-  std::printf("[ info ] screenshot: %s\n", (dir.path() / "browser.png").c_str());
+  keep_screenshot(dir, "browser-salt.png");
   EXPECT_TRUE(served.stop()) << served.log();
 }
 
@@ -227,11 +235,7 @@ async def scenario(call, js, until):
   EXPECT_EQ(status, 0) << out;
   expect_lines(out, {"connected True", "panel True", "books True", "on solids True", "on surface True",
                      "swatch rgb(156, 107, 28)", "tinted True", "reference True", "screenshot True"});
-  // THAW_TEST_SCREENSHOTS=DIR keeps the page.
-  if (const char* keep = std::getenv("THAW_TEST_SCREENSHOTS"))
-    std::filesystem::copy_file(dir.path() / "browser.png",
-                               std::filesystem::path(keep) / "browser-coating.png",
-                               std::filesystem::copy_options::overwrite_existing);
+  keep_screenshot(dir, "browser-coating.png");
   for (std::size_t at = out.find("[ info ]"); at != std::string::npos; at = out.find("[ info ]", at + 1))
     std::printf("%s\n", out.substr(at, out.find('\n', at) - at).c_str());
   EXPECT_TRUE(served.stop()) << served.log();
