@@ -200,12 +200,10 @@ int cmd_run(int argc, char** argv) {
                   1e6 * wall / double(steps) / double(std::max<std::size_t>(solver.size(), 1)));
       std::printf("stages, ms per step:");
       const auto& t = solver.timers();
-      // Stages this scene did not build never ran: they are left out.
-      for (int s = 0; s < static_cast<int>(Stage::Count); ++s)
-        if (t.seconds(static_cast<Stage>(s)) > 0.0)
-          std::printf("  %s %.3f (%.0f%%)", kStageNames[s],
-                      1e3 * t.seconds(static_cast<Stage>(s)) / double(steps),
-                      100.0 * t.seconds(static_cast<Stage>(s)) / std::max(t.total(), 1e-12));
+      // The stages this scene built, in step order.
+      for (const Stage s : solver.timed_stages())
+        std::printf("  %s %.3f (%.0f%%)", kStageNames[int(s)], 1e3 * t.seconds(s) / double(steps),
+                    100.0 * t.seconds(s) / std::max(t.total(), 1e-12));
     }
     std::printf(
         "\nfinal: dt %.3g s, max speed %.4g m/s, density error max %.3g %% mean %.3g %%, fluid mass %.9g kg, "

@@ -9,7 +9,7 @@
 #include "sim/cl_launch.h"
 #include "sim/fluid_stage.h"
 #include "sim/kernels/sph_kernel.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
 
 namespace thaw {
 
@@ -29,29 +29,27 @@ double dfsph_rest_ratio(const Scene& scene) {
   return sph::lattice_sum(w, scene.spacing, static_cast<float>(scene.solver.support_ratio * scene.spacing));
 }
 
-DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-                       const SolverConstants& k, const std::string& build_options,
-                       const ParticleLayout& layout, const cl::Buffer& flow, bool with_heat)
-    : cl_(cl),
-      store_(store),
-      f_(core),
-      layout_(layout),
+DfsphStage::DfsphStage(const StageContext& c, const cl::Buffer& flow, bool with_heat)
+    : cl_(c.cl),
+      store_(c.store),
+      f_(c.core),
+      layout_(c.layout),
       flow_(flow),
-      ideal_gas_(rest_density_reads_temperature(scene, with_heat)) {
+      ideal_gas_(rest_density_reads_temperature(c.scene, with_heat)) {
   // The accumulated (sum kappa dt^2, sum kappa dt) of the step's two solves: the next step's warm start,
   // saved so that a resumed run continues bitwise.
-  kappa_ = store.add({"dfsph_kappa", FieldType::Float32, 2});
+  kappa_ = c.store.add({"dfsph_kappa", FieldType::Float32, 2});
   std::ostringstream relaxation;
   relaxation.precision(9);
   relaxation << std::showpoint;  // 1 as "1.00000000f": OpenCL C has no "1f"
-  relaxation << build_options << " -DTHAW_OMEGA=" << scene.solver.pressure_relaxation << "f";
-  divergence_warm_start_ = scene.solver.divergence_warm_start;
-  extrapolate_ = scene.solver.boundary_pressure == DfsphBoundary::Adami2012;
+  relaxation << c.options << " -DTHAW_OMEGA=" << c.scene.solver.pressure_relaxation << "f";
+  divergence_warm_start_ = c.scene.solver.divergence_warm_start;
+  extrapolate_ = c.scene.solver.boundary_pressure == DfsphBoundary::Adami2012;
   if (extrapolate_) relaxation << " -DTHAW_DFSPH_EXTRAPOLATE";
   // The density solve's target: the density a resting lattice sums to (dfsph.cl, dfsph_error).
-  relaxation << " -DTHAW_DFSPH_LATTICE=" << dfsph_rest_ratio(scene) << "f";
+  relaxation << " -DTHAW_DFSPH_LATTICE=" << dfsph_rest_ratio(c.scene) << "f";
   if (ideal_gas_) relaxation << " -DTHAW_IDEAL_GAS";
-  const auto program = cl.build(
+  const auto program = c.cl.build(
       {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph_columns.h", "dfsph.cl"},
       relaxation.str());
   k_columns_ = cl::Kernel(program, "dfsph_columns");
@@ -60,9 +58,10 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   // low-Mach flow, Paolucci 1982). Without it the warming air's rest volumes outgrew the box, which the
   // solve cannot relieve: warm-plate-air blew up after 2.1 s. Air that fills only part of the domain
   // (air.region) has room to expand into and stays at the room's pressure.
-  const bool fills = scene.air.region.min == scene.domain.min && scene.air.region.max == scene.domain.max;
-  closed_gas_ = ideal_gas_ && scene.open_faces == 0 && fills;
-  lattice_volume_ = std::pow(scene.spacing, 3);
+  const bool fills =
+      c.scene.air.region.min == c.scene.domain.min && c.scene.air.region.max == c.scene.domain.max;
+  closed_gas_ = ideal_gas_ && c.scene.open_faces == 0 && fills;
+  lattice_volume_ = std::pow(c.scene.spacing, 3);
   if (closed_gas_) k_gas_volume_ = cl::Kernel(program, "dfsph_gas_volume");
   k_error_ = cl::Kernel(program, "dfsph_error");
   k_warm_ = cl::Kernel(program, "dfsph_warm");
@@ -72,29 +71,29 @@ DfsphStage::DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& co
   k_drift_ = cl::Kernel(program, "dfsph_drift");
   k_pressure_ = cl::Kernel(program, "dfsph_pressure");
   k_extrapolate_ = cl::Kernel(program, "dfsph_extrapolate");
-  support_ = k.support;
+  support_ = c.k.support;
   // The hydrostatic term of the walls' extrapolated pressure. Air feels no gravity but its buoyancy
   // (sim/scene.h, Buoyancy), a few per cent of g that is left out here: the walls of a scene of air alone
   // take the pressure of the air next to them.
   const bool air_alone =
-      scene.has_air() && scene.fluids.empty() && scene.emitters.empty() && scene.ice.empty();
-  const Eigen::Vector3d g = air_alone ? Eigen::Vector3d::Zero() : scene.gravity;
+      c.scene.has_air() && c.scene.fluids.empty() && c.scene.emitters.empty() && c.scene.ice.empty();
+  const Eigen::Vector3d g = air_alone ? Eigen::Vector3d::Zero() : c.scene.gravity;
   gravity_ = {{static_cast<float>(g.x()), static_cast<float>(g.y()), static_cast<float>(g.z()), 0.0f}};
   // A full neighbourhood holds about (4/3) pi (H / dx)^3 particles; below 60 % of it a particle is at a
   // surface, where the divergence solve leaves it (20 of 33 at H = 2 dx, SPlisHSPlasH's threshold).
   min_neighbours_ =
-      static_cast<cl_uint>(std::lround(0.6 * sph::full_neighbourhood(scene.spacing, k.support)));
-  rest_density_ = k.rest_density;
+      static_cast<cl_uint>(std::lround(0.6 * sph::full_neighbourhood(c.scene.spacing, c.k.support)));
+  rest_density_ = c.k.rest_density;
   // Multiphase builds measure the errors as fractions of each particle's own rest density (dfsph.cl).
-  error_scale_ = scene.multiphase() ? 1.0 : k.rest_density;
-  density_tolerance_ = scene.solver.density_tolerance;
-  divergence_tolerance_ = scene.solver.divergence_tolerance;
-  max_iterations_ = scene.solver.max_pressure_iterations;
-  const int columns = kColumns + (scene.multiphase() ? 2 : 0);  // VOL and RHO
-  col_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::size_t(layout.stride) * columns * 4);
+  error_scale_ = c.scene.multiphase() ? 1.0 : c.k.rest_density;
+  density_tolerance_ = c.scene.solver.density_tolerance;
+  divergence_tolerance_ = c.scene.solver.divergence_tolerance;
+  max_iterations_ = c.scene.solver.max_pressure_iterations;
+  const int columns = kColumns + (c.scene.multiphase() ? 2 : 0);  // VOL and RHO
+  col_ = cl::Buffer(c.cl.context(), CL_MEM_READ_WRITE, std::size_t(c.layout.stride) * columns * 4);
   // Lanes read up to 15 floats past the last particle: keep the padding finite.
-  cl.queue().enqueueFillBuffer(col_, 0.0f, 0, std::size_t(layout.stride) * columns * 4);
-  sums_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(layout.max_tiles, 1) * 8);
+  c.cl.queue().enqueueFillBuffer(col_, 0.0f, 0, std::size_t(c.layout.stride) * columns * 4);
+  sums_ = cl::Buffer(c.cl.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(c.layout.max_tiles, 1) * 8);
 }
 
 void DfsphStage::mark_fluid() {

@@ -4,10 +4,9 @@
 // walls' push) stay, the density pass computing alpha too; this stage replaces the pressure force by two
 // Jacobi solves on the velocities, the density solve warm-started from the last step (the divergence solve
 // from zero unless solver.divergence_warm_start), each stopped at its tolerance or the iteration cap
-// (sim/kernels/dfsph.cl has the equations). The step (Solver::step, 2017 Algorithm 1):
-//   grid, densities, alpha -> divergence solve (last step's dt) -> non-pressure forces -> dt from the
-//   velocity CFL -> v += dt a -> density solve -> x += dt v.
-// Built only for scenes that ask for it.
+// (sim/kernels/dfsph.cl has the equations). Its passes in the step (2017 Algorithm 1) are sim/step_plan.h's:
+// the divergence solve with the last step's dt after the densities and alpha, the density solve after v += dt
+// a. Built only for scenes that ask for it.
 #include <CL/opencl.hpp>
 #include <cstdint>
 #include <string>
@@ -48,9 +47,7 @@ class DfsphStage {
  public:
   // `flow` is the fluid stage's material table (each particle's rest density). `with_heat`: the heat stage
   // runs, so ideal-gas air's rest density follows its temperature (rest_density_reads_temperature).
-  DfsphStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-             const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
-             const cl::Buffer& flow, bool with_heat);
+  DfsphStage(const StageContext& c, const cl::Buffer& flow, bool with_heat);
   // With rest_density_reads_temperature(): the enthalpy field the columns read (the heat stage's).
   void rest_density_from(ParticleStore::Field enthalpy) { enthalpy_ = enthalpy; }
 

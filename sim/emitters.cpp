@@ -6,7 +6,8 @@
 #include <limits>
 
 #include "sim/error.h"
-#include "sim/solver.h"
+#include "sim/scene_sampling.h"
+#include "sim/substance_stage.h"
 #include "sim/thermal.h"
 
 namespace thaw {

@@ -4,7 +4,7 @@
 
 #include "sim/cl_launch.h"
 #include "sim/error.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
 
 namespace thaw {
 
@@ -93,65 +93,64 @@ bool buoyancy_reads_temperature(const Scene& scene, bool with_heat) {
           scene.air.buoyancy == Buoyancy::IdealGas || scene.air.artificial_buoyancy > 0);
 }
 
-FluidStage::FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-                       const SolverConstants& k, const std::string& build_options,
-                       const ParticleLayout& layout, bool with_heat)
-    : cl_(cl),
-      store_(store),
-      f_(core),
-      layout_(layout),
-      buoyancy_(buoyancy_reads_temperature(scene, with_heat)) {
+FluidStage::FluidStage(const StageContext& c, bool with_heat)
+    : cl_(c.cl),
+      store_(c.store),
+      f_(c.core),
+      layout_(c.layout),
+      buoyancy_(buoyancy_reads_temperature(c.scene, with_heat)) {
   const std::vector<std::string> prelude = {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h"};
   auto with = [&](std::initializer_list<std::string> files) {
     std::vector<std::string> all = prelude;
     all.insert(all.end(), files);
     return all;
   };
-  no_slip_ = scene.solver.no_slip == NoSlip::Adami2012;
+  no_slip_ = c.scene.solver.no_slip == NoSlip::Adami2012;
   const std::string slip = no_slip_ ? " -DTHAW_NO_SLIP" : "";
-  k_density_ = cl::Kernel(cl.build(with({"dfsph_columns.h", "density.cl"}), build_options + slip), "density");
+  k_density_ = cl::Kernel(c.cl.build(with({"dfsph_columns.h", "density.cl"}), c.options + slip), "density");
   k_forces_ = cl::Kernel(
-      cl.build(with({"forces.cl"}), build_options + slip + (buoyancy_ ? " -DTHAW_BUOYANCY" : "")), "forces");
-  const auto integrate = cl.build(with({"integrate.cl", "step_limits.cl"}), build_options);
+      c.cl.build(with({"forces.cl"}), c.options + slip + (buoyancy_ ? " -DTHAW_BUOYANCY" : "")), "forces");
+  const auto integrate = c.cl.build(with({"integrate.cl", "step_limits.cl"}), c.options);
   k_limits_ = cl::Kernel(integrate, "step_limits");
   k_integrate_ = cl::Kernel(integrate, "integrate");
 
-  const std::vector<fluid::MaterialFlow> table = material_flow_table(scene, k, with_heat);
-  auto& ctx = cl.context();
-  flow_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(fluid::MaterialFlow),
-                     const_cast<fluid::MaterialFlow*>(table.data()));
-  const std::size_t n = std::max<std::size_t>(layout.capacity, 1);
-  const std::size_t tiles = std::max<cl_uint>(layout.max_tiles, 1);
+  const std::vector<fluid::MaterialFlow> table = material_flow_table(c.scene, c.k, with_heat);
+  auto& ctx = c.cl.context();
+  flow_ =
+      cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(fluid::MaterialFlow),
+                   const_cast<fluid::MaterialFlow*>(table.data()));
+  const std::size_t n = std::max<std::size_t>(c.layout.capacity, 1);
+  const std::size_t tiles = std::max<cl_uint>(c.layout.max_tiles, 1);
   auto buf = [&](std::size_t bytes) {
     return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
   };
   state_ = buf(n * 16);
   accel_ = buf(n * 16);
-  derived_ = buf(std::size_t(layout.stride) * 3 * 4);
+  derived_ = buf(std::size_t(c.layout.stride) * 3 * 4);
   // The padding past the last particle is read by masked lanes only; keep it finite anyway.
-  cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(layout.stride) * 3 * 4);
+  c.cl.queue().enqueueFillBuffer(derived_, 0.0f, 0, std::size_t(c.layout.stride) * 3 * 4);
   if (no_slip_) {
-    ghost_ = buf(std::size_t(layout.stride) * 3 * 4);
-    cl.queue().enqueueFillBuffer(ghost_, 0.0f, 0, std::size_t(layout.stride) * 3 * 4);
+    ghost_ = buf(std::size_t(c.layout.stride) * 3 * 4);
+    c.cl.queue().enqueueFillBuffer(ghost_, 0.0f, 0, std::size_t(c.layout.stride) * 3 * 4);
   }
   limits_f_ = buf(tiles * 8);
   limits_i_ = buf(tiles * 8);
 
-  density_params_.support = k.support;
-  density_params_.gamma = static_cast<float>(scene.solver.gamma);
-  density_params_.visc_boundary = k.visc_boundary;
-  density_params_.stride = layout.stride;
-  density_params_.n = static_cast<cl_uint>(layout.n);
-  forces_params_.support = k.support;
-  forces_params_.eps2 = 0.01f * k.smoothing * k.smoothing;
-  forces_params_.gravity_x = float(scene.gravity.x());
-  forces_params_.gravity_y = float(scene.gravity.y());
-  forces_params_.gravity_z = float(scene.gravity.z());
-  forces_params_.rep_k = k.repulsion;
-  forces_params_.rep_r0 = k.repulsion_range;
-  forces_params_.rep_d = k.repulsion_damping;
-  forces_params_.stride = layout.stride;
-  forces_params_.n = static_cast<cl_uint>(layout.n);
+  density_params_.support = c.k.support;
+  density_params_.gamma = static_cast<float>(c.scene.solver.gamma);
+  density_params_.visc_boundary = c.k.visc_boundary;
+  density_params_.stride = c.layout.stride;
+  density_params_.n = static_cast<cl_uint>(c.layout.n);
+  forces_params_.support = c.k.support;
+  forces_params_.eps2 = 0.01f * c.k.smoothing * c.k.smoothing;
+  forces_params_.gravity_x = float(c.scene.gravity.x());
+  forces_params_.gravity_y = float(c.scene.gravity.y());
+  forces_params_.gravity_z = float(c.scene.gravity.z());
+  forces_params_.rep_k = c.k.repulsion;
+  forces_params_.rep_r0 = c.k.repulsion_range;
+  forces_params_.rep_d = c.k.repulsion_damping;
+  forces_params_.stride = c.layout.stride;
+  forces_params_.n = static_cast<cl_uint>(c.layout.n);
 }
 
 void FluidStage::density(const NeighbourView& nv) {

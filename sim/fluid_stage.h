@@ -48,9 +48,7 @@ struct FlowLimits {
 
 class FluidStage {
  public:
-  FluidStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-             const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
-             bool with_heat);
+  FluidStage(const StageContext& c, bool with_heat);
   // With buoyancy_reads_temperature(): the enthalpy field the forces pass reads (the heat stage's).
   void buoyancy_from(ParticleStore::Field enthalpy) { enthalpy_ = enthalpy; }
 

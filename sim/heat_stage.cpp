@@ -5,35 +5,35 @@
 #include <limits>
 #include <sstream>
 
+#include "sim/books.h"
 #include "sim/cl_launch.h"
 #include "sim/error.h"
 #include "sim/kernels/dryer_model.h"
 #include "sim/kernels/heat_params.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
 #include "sim/substance_stage.h"
 
 namespace thaw {
 
-HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-                     const HeatPlan& plan, const SolverConstants& k, const std::string& build_options,
-                     const ParticleLayout& layout, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi)
-    : cl_(cl),
-      store_(store),
-      core_(core),
-      scene_(scene),
+HeatStage::HeatStage(const StageContext& c, const HeatPlan& plan, const Eigen::Vector3f& lo,
+                     const Eigen::Vector3f& hi)
+    : cl_(c.cl),
+      store_(c.store),
+      core_(c.core),
+      scene_(c.scene),
       plan_(plan),
-      diffusion_dt_(k.diffusion_dt),
-      wall_dt_(k.wall_dt),
-      exposed_capacity_(k.exposed_capacity),
-      support_(k.support),
-      smoothing_(k.smoothing),
-      rest_density_(k.rest_density),
-      layout_(layout) {
-  enthalpy_ = store.add({"enthalpy", FieldType::Float32, 2});
+      diffusion_dt_(c.k.diffusion_dt),
+      wall_dt_(c.k.wall_dt),
+      exposed_capacity_(c.k.exposed_capacity),
+      support_(c.k.support),
+      smoothing_(c.k.smoothing),
+      rest_density_(c.k.rest_density),
+      layout_(c.layout) {
+  enthalpy_ = c.store.add({"enthalpy", FieldType::Float32, 2});
 
-  std::string opts = build_options;
+  std::string opts = c.options;
   if (uses_surface()) opts += " -DTHAW_SURFACE_AREA";
-  if (substances_lower_melting(scene)) opts += " -DTHAW_MELT_SHIFT";
+  if (substances_lower_melting(c.scene)) opts += " -DTHAW_MELT_SHIFT";
   if (plan.ambient) opts += " -DTHAW_AMBIENT";
   if (plan.dryers) opts += " -DTHAW_DRYERS";
   if (plan.walls) opts += " -DTHAW_WALL_HEAT";
@@ -41,44 +41,45 @@ HeatStage::HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core
   if (plan.adiabatic) opts += " -DTHAW_ADIABATIC";
   if (plan.air_faces) opts += " -DTHAW_AIR_FACES";
   for (int a = 0; a < 3; ++a)
-    if (scene.solver.periodic[static_cast<std::size_t>(a)])
+    if (c.scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
-  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h",
-                                 "dryer_model.h", "heat_params.h", "wrapped_walk.h", "heat.cl"},
-                                opts);
+  const auto program = c.cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h",
+                                   "dryer_model.h", "heat_params.h", "wrapped_walk.h", "heat.cl"},
+                                  opts);
   k_thermal_state_ = cl::Kernel(program, "thermal_state");
   k_heat_ = cl::Kernel(program, "heat");
   k_absorb_ = cl::Kernel(program, "absorb_photons");
   k_budget_ = cl::Kernel(program, "heat_budget");
   if (plan.adiabatic) k_adiabatic_ = cl::Kernel(program, "adiabatic_state");
 
-  auto& ctx = cl.context();
-  auto& q = cl.queue();
-  const std::size_t n = std::max<std::size_t>(layout.capacity, 1);
-  const std::size_t tiles = std::max<cl_uint>(layout.max_tiles, 1);
+  auto& ctx = c.cl.context();
+  auto& q = c.cl.queue();
+  const std::size_t n = std::max<std::size_t>(c.layout.capacity, 1);
+  const std::size_t tiles = std::max<cl_uint>(c.layout.max_tiles, 1);
   auto buf = [&](std::size_t bytes) {
     return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
   };
-  const std::vector<MaterialThermal> table = material_thermal_table(scene, k.rest_density);
-  materials_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                          table.size() * sizeof(MaterialThermal), const_cast<MaterialThermal*>(table.data()));
-  thermal_ = buf(std::size_t(layout.stride) * 3 * 4);
-  q.enqueueFillBuffer(thermal_, 0.0f, 0, std::size_t(layout.stride) * 3 * 4);
+  const std::vector<MaterialThermal> table = material_thermal_table(c.scene, c.k.rest_density);
+  materials_ =
+      cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(MaterialThermal),
+                   const_cast<MaterialThermal*>(table.data()));
+  thermal_ = buf(std::size_t(c.layout.stride) * 3 * 4);
+  q.enqueueFillBuffer(thermal_, 0.0f, 0, std::size_t(c.layout.stride) * 3 * 4);
   if (plan.lamps) {
     lamp_energy_ = buf(n * 4);
     q.enqueueFillBuffer(lamp_energy_, 0.0f, 0, n * 4);
   }
-  budget_parts_ = buf(std::size_t(layout.stride) * 5 * 4);
+  budget_parts_ = buf(std::size_t(c.layout.stride) * 5 * 4);
   budget_tiles_ = buf(tiles * 5 * 4);
   budget_bad_ = buf(tiles * 4);
   phase_changed_ = buf(4);
   q.enqueueFillBuffer(phase_changed_, cl_uint(0), 0, 4);
-  dryers_ = buf(std::max<std::size_t>(scene.dryers.size(), 1) * sizeof(dryer::DryerJet));
+  dryers_ = buf(std::max<std::size_t>(c.scene.dryers.size(), 1) * sizeof(dryer::DryerJet));
 
   // Voxels of one spacing over every particle: a lattice of that spacing puts one particle in each, at
   // the centre for the lattice through the lowest particle (not on a face, where rounding could put two
   // in one voxel and leave a hole next to it). Built once a lamp is on.
-  photon_grid_.cell = static_cast<float>(scene.spacing);
+  photon_grid_.cell = static_cast<float>(c.scene.spacing);
   photon_grid_.origin = lo - Eigen::Vector3f::Constant(1.5f * photon_grid_.cell);
   const Eigen::Vector3f span = hi + Eigen::Vector3f::Constant(photon_grid_.cell) - photon_grid_.origin;
   photon_grid_.nx = static_cast<int>(std::ceil(span.x() / photon_grid_.cell)) + 1;

@@ -27,9 +27,7 @@ class HeatStage {
  public:
   // `scene` must outlive the stage (the solver's own copy, whose dryers and lamps change live);
   // `particle_bounds` (min, max over every particle) sizes the photon grid.
-  HeatStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-            const HeatPlan& plan, const SolverConstants& k, const std::string& build_options,
-            const ParticleLayout& layout, const Eigen::Vector3f& particle_min,
+  HeatStage(const StageContext& c, const HeatPlan& plan, const Eigen::Vector3f& particle_min,
             const Eigen::Vector3f& particle_max);
   ~HeatStage();
 

@@ -1,10 +1,13 @@
 #pragma once
 // What a run reports per output interval (`--metrics FILE.jsonl`): conserved sums in double.
+#include "sim/books.h"
+#include "sim/emitters.h"
 #include "sim/particles.h"
 #include "sim/scene.h"
-#include "sim/solver.h"
 
 namespace thaw {
+
+class Solver;
 
 struct Metrics {
   double time = 0, dt = 0;

@@ -1,5 +1,7 @@
 // Turning a scene into particles: fluid and ice on a lattice, solids and walls as boundary particles, each
 // with the enthalpy of its initial temperature.
+#include "sim/scene_sampling.h"
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -10,7 +12,8 @@
 #include "sim/emitters.h"
 #include "sim/error.h"
 #include "sim/geometry/voxelize.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
+#include "sim/substance_stage.h"
 #include "sim/thermal.h"
 
 namespace thaw {

@@ -73,158 +73,6 @@ RigidIce::Settings rigid_settings(const Scene& scene, const SolverConstants& k) 
 
 }  // namespace
 
-SolverConstants derive_constants(const Scene& scene) {
-  const auto& s = scene.solver;
-  SolverConstants k;
-  k.support = static_cast<float>(s.support_ratio * scene.spacing);
-  k.smoothing = 0.5f * k.support;
-
-  // The first fluid block's material (or, in a scene of ice alone, the water it melts into) sets the rest
-  // density that boundary particles carry (Akinci 2012) and the stiffness scale; each fluid's own
-  // properties are rows of the flow table (material_flow_table in sim/fluid_stage.h).
-  int fluid_material = scene.fluids.empty() ? -1 : scene.fluids.front().material;
-  if (fluid_material < 0 && !scene.emitters.empty()) fluid_material = scene.emitters.front().material;
-  for (const auto& c : scene.ice)
-    if (fluid_material < 0) fluid_material = scene.materials[static_cast<std::size_t>(c.material)].partner;
-  if (fluid_material < 0 && scene.has_air()) fluid_material = scene.air.material;
-  const Material* fluid = fluid_material >= 0 ? &scene.materials[fluid_material] : nullptr;
-  k.rest_density = static_cast<float>(fluid ? fluid->density : 1000.0);
-  // The viscous limit on dt takes the largest kinematic viscosity of any fluid present or melted into.
-  double nu = 0;
-  auto consider = [&](int m) {
-    if (m < 0) return;
-    const Material& mat = scene.materials[static_cast<std::size_t>(m)];
-    if (flows(mat.kind)) nu = std::max(nu, double(static_cast<float>(mat.viscosity / mat.density)));
-  };
-  for (const auto& f : scene.fluids) consider(f.material);
-  for (const auto& c : scene.ice) consider(scene.materials[static_cast<std::size_t>(c.material)].partner);
-  for (const auto& e : scene.emitters) consider(e.material);
-  if (scene.has_air()) consider(scene.air.material);
-  k.kinematic_viscosity = static_cast<float>(nu);
-
-  // Reference speed: free fall from the highest fluid or ice to the bottom of the domain, or the fastest
-  // initial velocity, whichever is larger.
-  double v_ref = s.reference_speed;
-  if (v_ref <= 0) {
-    const double g = scene.gravity.norm();
-    if (g > 0) {
-      const Eigen::Vector3d up = -scene.gravity / g;
-      double top = -std::numeric_limits<double>::infinity();
-      // Ice turns into water where it stands, so its top counts too.
-      for (const auto& f : scene.fluids) top = std::max(top, f.box.max_along(up));
-      for (const auto& c : scene.ice) top = std::max(top, c.box.max_along(up));
-      const double bottom = -scene.domain.max_along(-up);
-      if (!scene.fluids.empty() || !scene.ice.empty())
-        v_ref = std::sqrt(2.0 * g * std::max(0.0, top - bottom));
-      // A jet lands at sqrt(v^2 + 2 g fall) (a closed tap may open at any time).
-      for (const auto& e : scene.emitters)
-        v_ref = std::max(v_ref,
-                         std::sqrt(e.speed * e.speed + 2.0 * g * std::max(0.0, up.dot(e.position) - bottom)));
-    }
-    for (const auto& f : scene.fluids) v_ref = std::max(v_ref, f.velocity.norm());
-    for (const auto& e : scene.emitters) v_ref = std::max(v_ref, e.speed);
-    for (const auto& d : scene.dryers)
-      if (d.model == DryerModel::Air) v_ref = std::max(v_ref, d.speed);
-    v_ref = std::max(v_ref, 0.1);  // a still fluid in zero gravity still needs a finite stiffness
-  }
-  // Tension's pair forces pull bulk water in with a cohesive pressure p_c that the equation of state holds:
-  // the stiffness must dwarf it as it does the flow's dynamic pressure, so v_ref is at least sqrt(2 p_c /
-  // rho0) (measured: iwasaki2010 drops of R = 10 spacings blew up in 65 steps at c = 10 sqrt(2 sigma / (rho
-  // R))).
-  if (scene.tension.enabled())
-    v_ref =
-        std::max(v_ref, std::sqrt(2.0 * tension_coefficients(scene, k).cohesive_pressure / k.rest_density));
-  k.sound_speed = static_cast<float>(s.speed_of_sound > 0 ? s.speed_of_sound : s.sound_speed_factor * v_ref);
-  k.max_speed = static_cast<float>(s.max_speed > 0 ? s.max_speed : 5.0 * k.sound_speed);
-  const float h = k.smoothing;
-  const fluid::MaterialFlow first = flow_row(s, k.rest_density, k.kinematic_viscosity, k.sound_speed, h);
-  k.stiffness = first.stiffness;
-  k.visc_fluid = first.viscosity;
-  k.visc_boundary = static_cast<float>(s.boundary_viscosity * k.sound_speed * h);
-  const double dx = scene.spacing;
-  // The walls' push is a spring of angular frequency c_push / dx: with WCSPH's acoustic step that is the
-  // sound speed. DFSPH's steps are as long as the flow allows, and symplectic Euler needs omega dt < 2:
-  // there the spring stiffens only enough to stop the fastest expected flow within a third of a spacing,
-  // c_push = 3 v_ref (omega dt = 0.66 at the default max_dt in a 25 cm column).
-  const double c_push = s.pressure == PressureSolver::Dfsph ? std::min(double(k.sound_speed), 3.0 * v_ref)
-                                                            : double(k.sound_speed);
-  k.repulsion = static_cast<float>(c_push * c_push / (dx * dx * k.rest_density * dx * dx * dx));
-  k.repulsion_range = static_cast<float>(0.95 * dx);
-  k.repulsion_damping = static_cast<float>(dx / c_push);
-  k.capillary_dt =
-      scene.tension.enabled()
-          ? std::sqrt(k.rest_density * dx * dx * dx / (2.0 * std::numbers::pi * scene.tension.coefficient))
-          : std::numeric_limits<double>::infinity();
-
-  const double inf = std::numeric_limits<double>::infinity();
-  const double alpha = max_diffusivity(scene);
-  k.diffusion_dt = alpha > 0 ? s.diffusion_number * double(h) * h / (scene.heat.time_scale * alpha) : inf;
-  // Explicit Newton cooling of a particle of capacity rho c dx^3 through at most 6 dx^2 is stable for
-  // dt < rho c dx / (6 h); the time step keeps half of that (Solver::heat_time_step).
-  k.exposed_capacity = inf;
-  k.wall_dt = inf;
-  for (const Material& m : scene.materials) {
-    if (m.kind == MaterialKind::Fluid || m.kind == MaterialKind::Ice)
-      k.exposed_capacity = std::min(k.exposed_capacity, m.density * m.specific_heat * dx / 6.0);
-    if (m.wall_heat) {
-      k.wall_dt = std::min(k.wall_dt, 0.5 * m.density * m.specific_heat * dx * wall_layer_count(scene) /
-                                          (scene.heat.time_scale * scene.heat.wall_coefficient));
-    }
-  }
-  return k;
-}
-
-std::vector<double> EnergyBudget::to_vector() const {
-  return {initial, ambient, lamps, dryers, walls, held, lamp_emitted, lamp_escaped, outflow, inflow};
-}
-
-OutflowBooks OutflowBooks::from_vector(const std::vector<double>& v) {
-  OutflowBooks b;
-  if (v.empty()) return b;
-  if (v.size() != 5) throw Error("outflow has " + std::to_string(v.size()) + " entries, expected 5");
-  b.particles = static_cast<std::uint64_t>(v[0]);
-  b.mass = v[1];
-  b.momentum = {v[2], v[3], v[4]};
-  return b;
-}
-
-std::vector<double> SubstanceBooks::to_vector() const {
-  std::vector<double> v = initial;
-  v.insert(v.end(), outflow.begin(), outflow.end());
-  v.insert(v.end(), inflow.begin(), inflow.end());
-  return v;
-}
-
-SubstanceBooks SubstanceBooks::from_vector(const std::vector<double>& v, std::size_t count) {
-  if (v.size() != 3 * count)
-    throw Error("state: the substances' account has " + std::to_string(v.size()) + " entries; the scene's " +
-                std::to_string(count) + " substances need " + std::to_string(3 * count));
-  SubstanceBooks b;
-  const auto at = [&](std::size_t k) { return v.begin() + static_cast<std::ptrdiff_t>(k * count); };
-  b.initial.assign(at(0), at(1));
-  b.outflow.assign(at(1), at(2));
-  b.inflow.assign(at(2), at(3));
-  return b;
-}
-
-EnergyBudget EnergyBudget::from_vector(const std::vector<double>& v) {
-  if (v.size() < 8 || v.size() > 10)
-    throw Error("energy budget has " + std::to_string(v.size()) +
-                " entries, expected 10 (8 before outflow, 9 before inflow)");
-  EnergyBudget b;
-  b.initial = v[0];
-  b.ambient = v[1];
-  b.lamps = v[2];
-  b.dryers = v[3];
-  b.walls = v[4];
-  b.held = v[5];
-  b.lamp_emitted = v[6];
-  b.lamp_escaped = v[7];
-  if (v.size() > 8) b.outflow = v[8];
-  if (v.size() > 9) b.inflow = v[9];
-  return b;
-}
-
 namespace {
 
 // Only the kernel and EOS this scene uses are compiled in.
@@ -364,39 +212,44 @@ void Solver::build(const SimState& st, std::size_t capacity) {
   store_.clear();
   grid_built_ = false;
   f_ = add_core_fields(store_);
+  const StageContext ctx{cl_, store_, f_, scene_, k_, opts, layout_};
   grid_ = std::make_unique<NeighbourGrid>(cl_, scene_, k_.support, kGridReach, opts, layout_, lo, hi);
   if (emitters_) grid_->set_room_sites(emitters_->room_sites());
-  if (scene_.solver.flow)
-    fluid_ = std::make_unique<FluidStage>(cl_, store_, f_, scene_, k_, opts, layout_, plan.build);
+  if (scene_.solver.flow) fluid_ = std::make_unique<FluidStage>(ctx, plan.build);
   if (fluid_ && scene_.solver.pressure == PressureSolver::Dfsph)
-    dfsph_ =
-        std::make_unique<DfsphStage>(cl_, store_, f_, scene_, k_, opts, layout_, fluid_->flow(), plan.build);
+    dfsph_ = std::make_unique<DfsphStage>(ctx, fluid_->flow(), plan.build);
   if (dfsph_) fluid_->compute_dfsph_alpha(dfsph_->columns(), dfsph_->min_neighbours());
-  if (fluid_ && scene_.tension.enabled())
-    tension_ = std::make_unique<TensionStage>(cl_, store_, f_, scene_, k_, opts, layout_);
+  if (fluid_ && scene_.tension.enabled()) tension_ = std::make_unique<TensionStage>(ctx);
   rigid_ = make_rigid_ice(cl_, store_, opts, scene_, k_, p, layout_.capacity, next_id_);
   if (rigid_ && fluid_ && dfsph_ && scene_.multiphase())
     rigid_->use_multiphase(fluid_->flow(), dfsph_->columns(), layout_.stride);
   forces_velocity_ = rigid_ && dfsph_
                          ? cl::Buffer(cl_.context(), CL_MEM_READ_WRITE, layout_.capacity * sizeof(cl_float4))
                          : cl::Buffer();
-  if (plan.build)
-    heat_ = std::make_unique<HeatStage>(cl_, store_, f_, scene_, plan, k_, opts, layout_, lo, hi);
+  if (plan.build) heat_ = std::make_unique<HeatStage>(ctx, plan, lo, hi);
   // The surface's areas where heat exchanges through them or surface-active substances sit on them.
   if ((heat_ && heat_->uses_surface()) || substances_need_surface(scene_))
-    surface_ = std::make_unique<SurfaceStage>(cl_, store_, f_, scene_, k_, opts, layout_);
+    surface_ = std::make_unique<SurfaceStage>(ctx);
   if (heat_ && heat_->uses_surface()) heat_->surface_from(surface_->area());
   if (!scene_.substances.empty()) {
     const ParticleStore::Field enthalpy = heat_ ? heat_->enthalpy() : 0;
     const SurfaceFields surface =
         surface_ ? SurfaceFields{surface_->area(), surface_->normal()} : SurfaceFields{};
     substances_ =
-        std::make_unique<SubstanceStage>(cl_, store_, f_, scene_, k_, opts, layout_,
-                                         heat_ ? &enthalpy : nullptr, surface_ ? &surface : nullptr);
+        std::make_unique<SubstanceStage>(ctx, heat_ ? &enthalpy : nullptr, surface_ ? &surface : nullptr);
   }
   if (substances_ && substances_->lowers_melting()) heat_->melt_shift_from(substances_->melt_shift());
   if (tension_ && substances_ && substances_lower_tension(scene_))
     tension_->ratio_from(substances_->tension_ratio());
+  plan_ = step_plan({.flow = fluid_ != nullptr,
+                     .dfsph = dfsph_ != nullptr,
+                     .tension = tension_ != nullptr,
+                     .rigid = rigid_ != nullptr,
+                     .heat = heat_ != nullptr,
+                     .photons = heat_ && !scene_.lamps.empty(),
+                     .surface = surface_ != nullptr,
+                     .substances = substances_ != nullptr,
+                     .emitters = emitters_ != nullptr});
   if (fluid_ && heat_) fluid_->buoyancy_from(heat_->enthalpy());
   if (dfsph_ && heat_) dfsph_->rest_density_from(heat_->enthalpy());
   store_.allocate(layout_.capacity);
@@ -752,111 +605,155 @@ void Solver::integrate(double dt) {
   if (fluid_) fluid_->integrate(dt, 1.0 / (1.0 + damping_ * dt));
 }
 
+// Walks the step's passes (sim/step_plan.h), each timed on its stage's timer.
 void Solver::step() {
-  if (dfsph_) {
-    step_dfsph();
-    return;
-  }
-  const bool flow = scene_.solver.flow;
-  // Without flow nothing moves: one sort serves the whole run.
-  if (flow || !grid_built_) timed(Stage::Grid, [&] { build_grid(); });
-  if (rigid_) timed(Stage::Bodies, [&] { rigid_->relabel_if_due(buffers(), steps_); });
-  if (flow) {
-    timed(Stage::Density, [&] { compute_density(); });
-    timed(Stage::Forces, [&] { compute_forces(); });
-    if (tension_) timed(Stage::Tension, [&] { tension_->run(neighbours(), fluid_->accel()); });
-  }
-  if (rigid_) timed(Stage::IceForces, [&] { rigid_->compute_forces(buffers()); });
   double dt = 0;
-  timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
-  update_surface();
-  if (substances_) timed(Stage::Substances, [&] { substances_->prepare(neighbours()); });
-  if (heat_) heat_stages(dt);
-  if (substances_) timed(Stage::Substances, [&] { substances_->diffuse(dt, neighbours()); });
-  if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
-  if (flow)
-    timed(Stage::Integrate, [&] {
-      grid_->drive_pipes(store_, f_);  // (its v += a dt then moves the pipes' air a little off)
-      integrate(dt);
-    });
-  time_ += dt;
-  dt_ = dt;
-  ++steps_;
-  if (emitters_) timed(Stage::Emit, [&] { emit(dt); });
+  for (const Pass p : plan_) run_pass(p, dt);
   report("step");
 }
 
-// Bender & Koschier 2017, Algorithm 1, started at its neighbourhood update: the densities and alpha of
-// the particles where the last step left them, the divergence solve with that step's dt, the non-pressure
-// forces, the time step from the velocities, heat, v += dt a, the density solve, then ice and positions.
-void Solver::step_dfsph() {
-  timed(Stage::Grid, [&] { build_grid(); });
-  if (rigid_) timed(Stage::Bodies, [&] { rigid_->relabel_if_due(buffers(), steps_); });
-  timed(Stage::Density, [&] { compute_density(); });  // with alpha for both solves
-  timed(Stage::Pressure, [&] { dfsph_->divergence_solve(neighbours(), dt_); });
-  timed(Stage::Forces, [&] {
-    compute_forces();
-    // Rigid ice's reaction to the viscous pair terms must see the velocities the water's side was
-    // computed from, or momentum is not exchanged exactly (measured: 1e-3 of the ice's momentum lost over
-    // 300 steps, RigidIceTest.IceAndWaterKeepTheirTotalMomentumUnderDfsph); the solves change them first.
-    if (rigid_ && n_ > 0)
-      cl_.queue().enqueueCopyBuffer(store_[f_.velocity], forces_velocity_, 0, 0, n_ * sizeof(cl_float4));
-  });
-  if (tension_) timed(Stage::Tension, [&] { tension_->run(neighbours(), fluid_->accel()); });
-  double dt = 0;
-  timed(Stage::TimeStep, [&] { dt = choose_time_step(); });
-  update_surface();
-  if (substances_) timed(Stage::Substances, [&] { substances_->prepare(neighbours()); });
-  if (heat_) heat_stages(dt);
-  if (substances_) timed(Stage::Substances, [&] { substances_->diffuse(dt, neighbours()); });
-  timed(Stage::Pressure, [&] {
-    dfsph_->predict(fluid_->accel(), neighbours(), dt, 1.0 / (1.0 + damping_ * dt));
-    dfsph_->density_solve(neighbours(), dt);
-    dfsph_->write_pressure(fluid_->state(), dt);
-  });
-  // Ice takes the reaction of the solves' pressure impulses and the forces pass's viscosity (rigid.cl), the
-  // latter from the velocities that pass saw.
-  if (rigid_)
-    timed(Stage::IceForces, [&] {
-      const ParticleBuffers b = buffers();
-      rigid_->compute_forces({b.position, forces_velocity_, b.state, b.phase, b.material, b.id, b.cell_start,
-                              b.grid, b.n, b.ids});
-    });
-  if (rigid_) timed(Stage::Bodies, [&] { rigid_->advance(buffers(), dt); });
-  timed(Stage::Integrate, [&] {
-    grid_->drive_pipes(store_, f_);
-    dfsph_->drift(dt);
-  });
-  time_ += dt;
-  dt_ = dt;
-  ++steps_;
-  if (emitters_) timed(Stage::Emit, [&] { emit(dt); });
-  report("step");
+void Solver::run_pass(Pass p, double& dt) {
+  Stage timer = Stage::Count;
+  pass_timer(p, timer);
+  switch (p) {
+    case Pass::Grid:
+      // Without flow nothing moves: one sort serves the whole run.
+      if (scene_.solver.flow || !grid_built_) timed(timer, [&] { build_grid(); });
+      break;
+    case Pass::Labels:
+      timed(timer, [&] { rigid_->relabel_if_due(buffers(), steps_); });
+      break;
+    case Pass::Density:  // with DFSPH's alpha for both solves
+      timed(timer, [&] { compute_density(); });
+      break;
+    case Pass::DivergenceSolve:
+      timed(timer, [&] { dfsph_->divergence_solve(neighbours(), dt_); });
+      break;
+    case Pass::Forces:
+      timed(timer, [&] {
+        compute_forces();
+        // Rigid ice's reaction to the viscous pair terms must see the velocities the water's side was
+        // computed from, or momentum is not exchanged exactly (RigidIceTest.IceAndWaterKeepTheirTotalMomentum
+        // UnderDfsph); DFSPH's solves change them before the ice takes its forces.
+        if (dfsph_ && rigid_ && n_ > 0)
+          cl_.queue().enqueueCopyBuffer(store_[f_.velocity], forces_velocity_, 0, 0, n_ * sizeof(cl_float4));
+      });
+      break;
+    case Pass::Tension:
+      timed(timer, [&] { tension_->run(neighbours(), fluid_->accel()); });
+      break;
+    case Pass::IceForces:
+      timed(timer, [&] {
+        if (!dfsph_) return rigid_->compute_forces(buffers());
+        // After DFSPH's solves: their pressure impulses, and the forces pass's viscosity from the velocities
+        // that pass saw (rigid.cl).
+        const ParticleBuffers b = buffers();
+        rigid_->compute_forces({b.position, forces_velocity_, b.state, b.phase, b.material, b.id,
+                                b.cell_start, b.grid, b.n, b.ids});
+      });
+      break;
+    case Pass::TimeStep:
+      timed(timer, [&] { dt = choose_time_step(); });
+      break;
+    case Pass::Surface:
+      update_surface();
+      break;
+    case Pass::SubstanceState:
+      timed(timer, [&] { substances_->prepare(neighbours()); });
+      break;
+    case Pass::Photons:
+      timed(timer, [&] { trace_photons(dt); });
+      break;
+    case Pass::Heat:
+      timed(timer, [&] { compute_heat(dt); });
+      break;
+    case Pass::SubstanceDiffusion:
+      timed(timer, [&] { substances_->diffuse(dt, neighbours()); });
+      break;
+    case Pass::DensitySolve:
+      timed(timer, [&] {
+        dfsph_->predict(fluid_->accel(), neighbours(), dt, 1.0 / (1.0 + damping_ * dt));
+        dfsph_->density_solve(neighbours(), dt);
+        dfsph_->write_pressure(fluid_->state(), dt);
+      });
+      break;
+    case Pass::Bodies:
+      timed(timer, [&] { rigid_->advance(buffers(), dt); });
+      break;
+    case Pass::Integrate:
+      timed(timer, [&] {
+        grid_->drive_pipes(store_, f_);  // (WCSPH's v += a dt then moves the pipes' air a little off)
+        if (dfsph_)
+          dfsph_->drift(dt);
+        else
+          integrate(dt);
+      });
+      break;
+    case Pass::Advance:
+      time_ += dt;
+      dt_ = dt;
+      ++steps_;
+      break;
+    case Pass::Emit:
+      timed(timer, [&] { emit(dt); });
+      break;
+  }
 }
 
 void Solver::hold_ice(bool held) {
   if (rigid_) rigid_->hold(held);
 }
 
+// The step's passes that change no state, at dt = 0: a sort of sorted keys is the identity, and dt = 0 leaves
+// x, v and the enthalpy unchanged (the air dryers take nothing in; the solves, diffusion and bodies wait for
+// a step).
 void Solver::warm_up() {
-  // A sort of sorted keys is the identity and dt = 0 leaves x and v unchanged, so this changes no state
-  // (the air dryers take nothing in).
-  build_grid(false);
-  // The first labelling is due before the first step anyway, at these same positions.
-  if (rigid_) rigid_->relabel_if_due(buffers(), steps_);
-  compute_density();
-  compute_forces();
-  if (tension_) tension_->run(neighbours(), fluid_->accel());
-  if (rigid_) rigid_->compute_forces(buffers());
-  choose_time_step();
-  integrate(0.0);
-  // dt = 0 adds no heat; the budget's sums of zero leave it unchanged.
-  if (surface_ && !surface_done_) {
-    surface_->run(neighbours());
-    surface_done_ = true;
+  for (const Pass p : plan_) {
+    switch (p) {
+      case Pass::Grid:
+        build_grid(false);
+        break;
+      case Pass::Labels:  // the first labelling is due before the first step anyway, at these positions
+        rigid_->relabel_if_due(buffers(), steps_);
+        break;
+      case Pass::Density:
+        compute_density();
+        break;
+      case Pass::Forces:
+        compute_forces();
+        break;
+      case Pass::Tension:
+        tension_->run(neighbours(), fluid_->accel());
+        break;
+      case Pass::IceForces:
+        rigid_->compute_forces(buffers());
+        break;
+      case Pass::TimeStep:
+        choose_time_step();
+        break;
+      case Pass::Surface:
+        if (!surface_done_) surface_->run(neighbours());
+        surface_done_ = true;
+        break;
+      case Pass::SubstanceState:
+        substances_->prepare(neighbours());
+        break;
+      case Pass::Heat:
+        heat_->warm_up(neighbours(), budget_);  // its sums of zero leave the budget unchanged
+        break;
+      case Pass::Integrate:
+        integrate(0.0);
+        break;
+      case Pass::DivergenceSolve:
+      case Pass::Photons:
+      case Pass::SubstanceDiffusion:
+      case Pass::DensitySolve:
+      case Pass::Bodies:
+      case Pass::Advance:
+      case Pass::Emit:
+        break;
+    }
   }
-  if (substances_) substances_->prepare(neighbours());  // (diffusing waits for a step)
-  if (heat_) heat_->warm_up(neighbours(), budget_);
   cl_.queue().finish();
 }
 
@@ -908,27 +805,48 @@ bool Solver::set_emitter(std::size_t index, const Emitter& e) {
 }
 
 std::vector<std::string> Solver::stages() const {
-  std::vector<std::string> out = {"grid"};
-  if (fluid_) out.insert(out.end(), {"density", "forces"});
-  if (tension_) out.push_back(std::string("tension (") + name(scene_.tension.model) + ")");
-  // A newcomer sees which form holds air beside water (the same solve, other passes).
-  if (dfsph_)
-    out.push_back(scene_.multiphase()
-                      ? std::string("pressure (dfsph, multiphase ") + name(scene_.solver.multiphase) +
-                            (scene_.air.buoyancy == Buoyancy::IdealGas ? ", eq 7's ideal-gas air)" : ")")
-                      : std::string("pressure (dfsph)"));
-  if (rigid_) out.push_back("rigid ice");
-  out.push_back("time step");
-  if (heat_ && heat_->tracing_photons()) out.push_back("photons");
-  if (heat_ && !heat_->tracing_photons() && !scene_.lamps.empty())
-    out.push_back("photons (when a lamp is on)");
-  if (surface_) out.push_back(std::string("surface (") + name(surface_->model()) + ")");
-  if (heat_) out.push_back("heat (" + heat_reason_ + ")");
-  if (substances_) out.push_back("substances (" + std::to_string(scene_.substances.size()) + ")");
-  if (fluid_) out.push_back("integrate");
-  // A scene without taps or dryers has this stage for its open sides: say so.
-  if (emitters_)
-    out.push_back(EmitterStage::admits_room_air(scene_) ? "emit (room air through open sides)" : "emit");
+  std::vector<std::string> out;
+  std::vector<std::string> named;
+  for (const Pass p : plan_) {
+    const std::string stage = pass_stage(p);
+    if (stage.empty() || std::find(named.begin(), named.end(), stage) != named.end()) continue;
+    named.push_back(stage);
+    // What a newcomer needs beside the name: the model, the form that holds air beside water, why heat was
+    // built.
+    if (p == Pass::Tension) {
+      out.push_back(stage + " (" + name(scene_.tension.model) + ")");
+    } else if (p == Pass::DivergenceSolve) {
+      out.push_back(scene_.multiphase()
+                        ? "pressure (dfsph, multiphase " + std::string(name(scene_.solver.multiphase)) +
+                              (scene_.air.buoyancy == Buoyancy::IdealGas ? ", eq 7's ideal-gas air)" : ")")
+                        : "pressure (dfsph)");
+    } else if (p == Pass::Photons) {
+      if (heat_->tracing_photons())
+        out.push_back(stage);
+      else if (!scene_.lamps.empty())
+        out.push_back("photons (when a lamp is on)");
+    } else if (p == Pass::Surface) {
+      out.push_back(stage + " (" + name(surface_->model()) + ")");
+    } else if (p == Pass::Heat) {
+      out.push_back("heat (" + heat_reason_ + ")");
+    } else if (p == Pass::SubstanceState) {
+      out.push_back("substances (" + std::to_string(scene_.substances.size()) + ")");
+    } else if (p == Pass::Emit) {
+      // A scene without taps or dryers has this stage for its open sides: say so.
+      out.push_back(EmitterStage::admits_room_air(scene_) ? "emit (room air through open sides)" : "emit");
+    } else {
+      out.push_back(stage);
+    }
+  }
+  return out;
+}
+
+std::vector<Stage> Solver::timed_stages() const {
+  std::vector<Stage> out;
+  for (const Pass p : plan_) {
+    Stage t = Stage::Count;
+    if (pass_timer(p, t) && std::find(out.begin(), out.end(), t) == out.end()) out.push_back(t);
+  }
   return out;
 }
 

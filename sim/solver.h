@@ -1,14 +1,13 @@
 #pragma once
-// Weakly compressible SPH water with static boundary particles, heat with phase change, and ice as rigid
-// bodies, stepped on an OpenCL device. One step (see Solver::step): grid -> [ice labels] -> density ->
-// forces -> [ice forces] -> time step -> photons -> heat -> [bodies] -> integrate -> [emit]; a scene
-// without heat builds no heat stages, one without free ice no rigid stages (sim/rigid_ice.h), one with the
-// flow off none of the fluid ones, one without emitters no emitter stage (sim/emitters.h).
+// The solver: builds the stages a scene needs (sim/stage.h), loads a state into them and steps it on an
+// OpenCL device, walking the step's passes in sim/step_plan.h's order; it keeps the run's books
+// (sim/books.h). Stages a scene does not need are not built: docs/ARCHITECTURE.md says which and when.
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "sim/books.h"
 #include "sim/cl_runtime.h"
 #include "sim/dfsph_stage.h"
 #include "sim/emitters.h"
@@ -19,83 +18,20 @@
 #include "sim/particle_store.h"
 #include "sim/particles.h"
 #include "sim/scene.h"
+#include "sim/scene_sampling.h"
+#include "sim/solver_constants.h"
 #include "sim/stage_timers.h"
 #include "sim/state_file.h"
+#include "sim/step_plan.h"
 #include "sim/substance_stage.h"
 #include "sim/surface_stage.h"
 #include "sim/tension_stage.h"
 
 namespace thaw {
 
-// Constants the scene implies, derived once (speed of sound, kernel radius, EOS stiffness).
-struct SolverConstants {
-  float support = 0;              // kernel support radius H [m]
-  float smoothing = 0;            // h = H / 2 (CFL and viscosity length) [m]
-  float rest_density = 0;         // rho0 of the fluid [kg/m^3]
-  float sound_speed = 0;          // c [m/s]
-  float stiffness = 0;            // Tait B = rho0 c^2 / gamma, or rho0 c^2 for the linear EOS [Pa]
-  float kinematic_viscosity = 0;  // physical nu [m^2/s]
-  float max_speed = 0;            // blow-up threshold [m/s]
-  // Viscosity coefficients of the forces pass: 2(d+2) nu + alpha c h between fluid particles (Monaghan
-  // 2005 eq. 4.8 and its artificial-viscosity equivalent), alpha_b c h against boundary particles.
-  float visc_fluid = 0, visc_boundary = 0;
-  // Solid particles push fluid particles closer than repulsion_range (0.95 dx) apart, a spring of pair
-  // stiffness m_i m_b repulsion [1/(kg s^2)] = c^2 / (dx^2 rho0 dx^3), as stiff as the ice contacts, with
-  // a dashpot of time repulsion_damping = dx / c [s] (forces.cl).
-  float repulsion = 0, repulsion_range = 0, repulsion_damping = 0;
-  // Tension's capillary limit on dt, sqrt(rho0 dx^3 / (2 pi sigma)) (Brackbill et al. 1992) [s]; infinite
-  // without tension.
-  double capillary_dt = 0;
-  // Heat: the diffusion limit on dt [s] (infinite without conduction), and the smallest heat capacity
-  // per exposed area rho c dx / 6 over the materials that exchange heat with the air [J/m^2/K].
-  double diffusion_dt = 0;
-  double exposed_capacity = 0;
-  double wall_dt = 0;  // the tank walls' exchange limit on dt [s] (infinite without wall heat)
-};
-
-// The run's energy account [J]: enthalpy at the start and the heat that came in since, by source.
-// Closure: total enthalpy now - initial - heat_in() is round-off (conduction and phase change move
-// heat only between particles).
-struct EnergyBudget {
-  double initial = 0;
-  double ambient = 0, lamps = 0, dryers = 0, walls = 0, held = 0;
-  double lamp_emitted = 0, lamp_escaped = 0;  // photons: emitted = absorbed (lamps) + escaped
-  double outflow = 0;  // enthalpy m h carried out by water that left through an open side
-  double inflow = 0;   // enthalpy m h brought in by emitters
-  double heat_in() const { return ambient + lamps + dryers + walls + held - outflow + inflow; }
-  std::vector<double> to_vector() const;
-  // Throws Error on a wrong length; files written before outflow existed have 8 entries (outflow 0),
-  // before inflow 9.
-  static EnergyBudget from_vector(const std::vector<double>& v);
-};
-
-// What left through the domain's open sides (Scene::open_faces): particles, their physical mass [kg] and
-// momentum [kg m/s]. Mass closes: the fluid's mass now + mass = its mass at the start.
-struct OutflowBooks {
-  std::uint64_t particles = 0;
-  double mass = 0;
-  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
-  std::vector<double> to_vector() const {
-    return {double(particles), mass, momentum.x(), momentum.y(), momentum.z()};
-  }
-  static OutflowBooks from_vector(const std::vector<double>& v);  // empty: nothing has left
-};
-
-// Each substance's account [kg] (sim/substance_stage.h), in the scene's order: its total at the start, what
-// left through open sides since and what emitters poured. Closure: the total now + outflow = initial +
-// inflow, to round-off.
-struct SubstanceBooks {
-  std::vector<double> initial, outflow, inflow;
-  double closure(std::size_t s, double total) const { return total + outflow[s] - initial[s] - inflow[s]; }
-  std::vector<double> to_vector() const;  // initial, outflow, inflow
-  // Throws Error unless `v` holds three entries per substance (3 * count).
-  static SubstanceBooks from_vector(const std::vector<double>& v, std::size_t count);
-};
-
 class PhotonTracer;
 class RigidIce;
 struct ParticleBuffers;
-SolverConstants derive_constants(const Scene& scene);
 
 class RunDigest;
 
@@ -188,6 +124,10 @@ class Solver {
   void compute_ice_forces();
   std::vector<Float4> ice_forces() const;
 
+  // The passes of its steps, in order (sim/step_plan.h).
+  const std::vector<Pass>& plan() const { return plan_; }
+  // The timers its passes add to, in step order (`thaw run` prints them so).
+  std::vector<Stage> timed_stages() const;
   // The stages this run built, in step order, e.g. {"grid", "density", "forces", "time step",
   // "integrate"}; heat names why it was built ("heat (the scene has dryers)").
   std::vector<std::string> stages() const;
@@ -263,10 +203,11 @@ class Solver {
   std::unique_ptr<FluidStage> fluid_;
   // The incompressible pressure solver (sim/dfsph_stage.h), built only when solver.pressure is dfsph.
   std::unique_ptr<DfsphStage> dfsph_;
+  std::vector<Pass> plan_;  // the step's passes (build() makes it from the stages built)
+  void run_pass(Pass p, double& dt);
   // DFSPH with free ice: the velocities the forces pass saw, kept for rigid ice's viscous reaction (the
   // solves change the water's velocities before the ice takes it).
   cl::Buffer forces_velocity_;
-  void step_dfsph();
   // Particles clamped back into the domain (counted by the grid's cell-key pass).
   cl::Buffer clamped_;
 
@@ -290,17 +231,5 @@ class Solver {
   // Emitters (built only when the scene has some); kept when the solver grows its capacity.
   std::unique_ptr<EmitterStage> emitters_;
 };
-
-// Samples a scene into particles: fluid blocks on a lattice, static solids and domain walls as
-// boundary particles (their Psi is computed on the device when the solver starts).
-HostParticles sample_scene(const Scene& scene);
-
-// Where the room's air comes in through the open sides (Scene::open_faces) of a scene with air: the points
-// of the air's lattice (its region, less solids and air dryers' pipes) within one spacing of an open
-// side. Empty without air or open sides. EmitterStage lays air at those that no particle is near.
-std::vector<Eigen::Vector3d> room_air_sites(const Scene& scene);
-
-// The state a run starts from: sampled particles at t = 0.
-SimState initial_state(const Scene& scene);
 
 }  // namespace thaw

@@ -1,17 +1,16 @@
 #pragma once
-// What the stages of a step share (sim/solver.h lists the step). A stage is a class built by the solver
-// only when the scene needs it; its constructor declares the particle fields it owns in the store
-// (sim/particle_store.h) and builds its kernels with only the options the scene uses; it offers its
-// limit on the time step (max_dt) and the state it keeps beyond its fields (save / restore) where it has
-// any, and its run methods take the views below. The stages today: NeighbourGrid
-// (sim/neighbour_grid.h), the fluid passes (Solver), RigidIce (sim/rigid_ice.h), HeatStage with its
-// photons (sim/heat_stage.h).
+// What the stages of a step share. A stage is a class the solver builds only when the scene needs it, from a
+// StageContext; its constructor declares the particle fields it owns in the store (sim/particle_store.h) and
+// builds its kernels with only the options the scene uses; it offers its limit on the time step (max_dt) and
+// the state it keeps beyond its fields (save / restore) where it has any, and its passes take the views
+// below. The order of the passes in a step is sim/step_plan.h's; docs/ARCHITECTURE.md lists the stages.
 #include <CL/opencl.hpp>
 #include <algorithm>
 #include <cstddef>
 
 #include "sim/cl_grid.h"
 #include "sim/particle_store.h"
+#include "sim/solver_constants.h"
 
 namespace thaw {
 
@@ -76,5 +75,18 @@ inline CoreFields add_core_fields(ParticleStore& store) {
   }
   return f;
 }
+
+// What every stage is built from: the run's device, its particle store and core fields, the scene and the
+// constants it implies, the kernels' build options (the SPH kernel, the equation of state, the lanes:
+// program_options in sim/solver.cpp) and the particles' layout.
+struct StageContext {
+  ClRuntime& cl;
+  ParticleStore& store;
+  const CoreFields& core;
+  const Scene& scene;
+  const SolverConstants& k;
+  const std::string& options;
+  const ParticleLayout& layout;
+};
 
 }  // namespace thaw

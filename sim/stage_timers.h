@@ -7,13 +7,7 @@
 
 namespace thaw {
 
-// IceForces and Bodies run only in scenes with free ice (sim/rigid_ice.h): the forces on ice particles,
-// and labelling, per-body sums, rigid integration and placing the ice particles. Emit runs only in scenes
-// with emitters (sim/emitters.h), and includes growing the capacity. Pressure runs only with DFSPH
-// (sim/dfsph_stage.h): alpha, the divergence and density solves, and the predicted velocities. Surface runs
-// only where the heat stage takes its exposed areas from it (sim/surface_stage.h); Tension only with
-// tension.model (sim/tension_stage.h), after Forces; Substances only where the scene declares substances
-// (sim/substance_stage.h), after Heat.
+// One timer per stage; the passes that add to each, and when each is built, are sim/step_plan.h's.
 enum class Stage {
   Grid,
   Density,

@@ -19,9 +19,10 @@
 #include <type_traits>
 #include <vector>
 
+#include "sim/books.h"
 #include "sim/error.h"
 #include "sim/scene.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
 #include "sim/substance_stage.h"
 #include "sim/thermal.h"
 

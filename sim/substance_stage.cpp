@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "sim/cl_launch.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
 #include "sim/thermal.h"
 
 namespace thaw {
@@ -115,23 +115,21 @@ bool substances_rejected_by_ice(const Scene& scene) {
                      [](const Substance& s) { return !s.enters_ice; });
 }
 
-SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core,
-                               const Scene& scene, const SolverConstants& k, const std::string& build_options,
-                               const ParticleLayout& layout, const ParticleStore::Field* enthalpy,
+SubstanceStage::SubstanceStage(const StageContext& c, const ParticleStore::Field* enthalpy,
                                const SurfaceFields* surface)
-    : cl_(cl), store_(store), core_(core), scene_(scene), layout_(layout) {
-  for (const Substance& s : scene.substances) {
-    fields_.push_back(store.add(substance_field(s.name)));
+    : cl_(c.cl), store_(c.store), core_(c.core), scene_(c.scene), layout_(c.layout) {
+  for (const Substance& s : c.scene.substances) {
+    fields_.push_back(c.store.add(substance_field(s.name)));
     diffusivity_.push_back(s.diffusivity);
     adsorbed_.push_back(-1);
     if (s.surface_active() && surface) {
       adsorbed_.back() = static_cast<int>(adsorbed_fields_.size());
-      adsorbed_fields_.push_back(store.add(adsorbed_field(s.name)));
+      adsorbed_fields_.push_back(c.store.add(adsorbed_field(s.name)));
     }
     deposited_.push_back(-1);
     if (s.coating()) {
       deposited_.back() = static_cast<int>(deposited_fields_.size());
-      deposited_fields_.push_back(store.add(deposited_field(s.name)));
+      deposited_fields_.push_back(c.store.add(deposited_field(s.name)));
     }
   }
   surface_ = !adsorbed_fields_.empty();
@@ -139,35 +137,35 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   if (surface_) surface_fields_ = *surface;
   // The shift is a field wherever the scene's substances lower the melting point (a state file keeps it for
   // the temperatures it shows), and renewed here only where heat reads it.
-  has_shift_ = substances_lower_melting(scene);
-  if (has_shift_) shift_ = store.add(melt_shift_field());
+  has_shift_ = substances_lower_melting(c.scene);
+  if (has_shift_) shift_ = c.store.add(melt_shift_field());
   lowers_ = enthalpy && has_shift_;
-  const bool rejects = enthalpy && substances_rejected_by_ice(scene);
-  std::string opts = build_options + " -DTHAW_NSUB=" + std::to_string(scene.substances.size());
+  const bool rejects = enthalpy && substances_rejected_by_ice(c.scene);
+  std::string opts = c.options + " -DTHAW_NSUB=" + std::to_string(c.scene.substances.size());
   if (lowers_) opts += " -DTHAW_MELT_SHIFT";
   if (rejects) opts += " -DTHAW_REJECT";
   if (surface_) opts += " -DTHAW_SURFACE";
   if (deposit_) opts += " -DTHAW_DEPOSIT";
-  lowers_tension_ = surface_ && substances_lower_tension(scene);
+  lowers_tension_ = surface_ && substances_lower_tension(c.scene);
   if (lowers_tension_) {
     opts += " -DTHAW_TENSION_LAW";
-    ratio_ = store.add(tension_ratio_field());
-    for (std::size_t s = 0; s < scene.substances.size(); ++s) {
-      const Substance& sub = scene.substances[s];
+    ratio_ = c.store.add(tension_ratio_field());
+    for (std::size_t s = 0; s < c.scene.substances.size(); ++s) {
+      const Substance& sub = c.scene.substances[s];
       if (!sub.lowers_tension()) continue;
       params_.tension_law |= (sub.tension_law == TensionLaw::Szyszkowski ? 1u : 2u) << (2 * s);
       float* e[4] = {&params_.tension0, &params_.tension1, &params_.tension2, &params_.tension3};
-      *e[s] = static_cast<float>(sub.tension_scale / scene.tension.coefficient);
+      *e[s] = static_cast<float>(sub.tension_scale / c.scene.tension.coefficient);
     }
   }
   ice_pass_ = lowers_ || rejects;
   if (enthalpy) enthalpy_ = *enthalpy;
   for (int a = 0; a < 3; ++a)
-    if (scene.solver.periodic[static_cast<std::size_t>(a)])
+    if (c.scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
-  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h",
-                                 "thermal_law.h", "liquidus.h", "substance_params.h", "substance.cl"},
-                                opts);
+  const auto program = c.cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h",
+                                   "thermal_law.h", "liquidus.h", "substance_params.h", "substance.cl"},
+                                  opts);
   k_state_ = cl::Kernel(program, "substance_state");
   if (ice_pass_) k_ice_ = cl::Kernel(program, "substance_ice");
   k_diffuse_ = cl::Kernel(program, "substance_diffuse");
@@ -181,57 +179,58 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   // Zeros past the particles too: the walk's lanes read a few floats beyond each cell's last one. The
   // blocks: M, A, W per substance; with surface-active ones AS, NRM, MOM, PX, PY, PZ, NX, NY, NZ, G per
   // substance; with coatings F, R per substance.
-  const std::size_t count = scene.substances.size();
-  const std::size_t bytes =
-      std::size_t(layout.stride) * (2 + count + (surface_ ? 9 + count : 0) + (deposit_ ? 1 + count : 0)) * 4;
-  sub_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, bytes);
-  cl.queue().enqueueFillBuffer(sub_, 0.0f, 0, bytes);
+  const std::size_t count = c.scene.substances.size();
+  const std::size_t bytes = std::size_t(c.layout.stride) *
+                            (2 + count + (surface_ ? 9 + count : 0) + (deposit_ ? 1 + count : 0)) * 4;
+  sub_ = cl::Buffer(c.cl.context(), CL_MEM_READ_WRITE, bytes);
+  c.cl.queue().enqueueFillBuffer(sub_, 0.0f, 0, bytes);
   // Each material's rest density and cryoscopic constant (ice: that of the water it melts into).
   std::vector<float> fluid;
-  for (const Material& m : scene.materials) {
+  for (const Material& m : c.scene.materials) {
     const Material* solvent = m.kind == MaterialKind::Fluid ? &m
                               : m.kind == MaterialKind::Ice && m.partner >= 0
-                                  ? &scene.materials[static_cast<std::size_t>(m.partner)]
+                                  ? &c.scene.materials[static_cast<std::size_t>(m.partner)]
                                   : nullptr;
     fluid.push_back(static_cast<float>(m.density));
     fluid.push_back(static_cast<float>(solvent ? solvent->cryoscopic_constant : 0.0));
   }
-  fluid_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, fluid.size() * 4, fluid.data());
+  fluid_ =
+      cl::Buffer(c.cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, fluid.size() * 4, fluid.data());
   std::vector<float> law;  // each material's L, c_solid, c_liquid and physical over SPH mass
-  for (const thermal::MaterialThermal& m : material_thermal_table(scene, k.rest_density))
+  for (const thermal::MaterialThermal& m : material_thermal_table(c.scene, c.k.rest_density))
     law.insert(law.end(), {m.latent, m.c_solid, m.c_liquid, m.thermal_mass_scale});
-  law_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, law.size() * 4, law.data());
-  liquidus_table_ = liquidus_table(scene);  // each substance's phase diagram
-  liquidus_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                         liquidus_table_.size() * sizeof(thermal::Liquidus), liquidus_table_.data());
+  law_ = cl::Buffer(c.cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, law.size() * 4, law.data());
+  liquidus_table_ = liquidus_table(c.scene);  // each substance's phase diagram
+  liquidus_ = cl::Buffer(c.cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                           liquidus_table_.size() * sizeof(thermal::Liquidus), liquidus_table_.data());
 
-  params_.support = k.support;
-  params_.eta2 = 0.01f * k.smoothing * k.smoothing;
+  params_.support = c.k.support;
+  params_.eta2 = 0.01f * c.k.smoothing * c.k.smoothing;
   float* period[3] = {&params_.period_x, &params_.period_y, &params_.period_z};
   for (int a = 0; a < 3; ++a)
-    if (scene.solver.periodic[static_cast<std::size_t>(a)])
-      *period[a] = static_cast<float>(scene.domain.max[a] - scene.domain.min[a]);
-  params_.flow = scene.solver.flow ? 1u : 0u;
-  for (std::size_t s = 0; s < scene.substances.size(); ++s)
-    if (!scene.substances[s].enters_ice) params_.reject |= 1u << s;
+    if (c.scene.solver.periodic[static_cast<std::size_t>(a)])
+      *period[a] = static_cast<float>(c.scene.domain.max[a] - c.scene.domain.min[a]);
+  params_.flow = c.scene.solver.flow ? 1u : 0u;
+  for (std::size_t s = 0; s < c.scene.substances.size(); ++s)
+    if (!c.scene.substances[s].enters_ice) params_.reject |= 1u << s;
 
   // Explicit diffusion is stable for D dt / h^2 below about 1/6 in 3-D; heat keeps the same margin.
   const double D = diffusivity_.empty() ? 0.0 : *std::max_element(diffusivity_.begin(), diffusivity_.end());
-  const double h = k.smoothing;
-  max_dt_ = D > 0 ? scene.solver.diffusion_number * h * h / D : std::numeric_limits<double>::infinity();
-  rest_density_ = k.rest_density;
+  const double h = c.k.smoothing;
+  max_dt_ = D > 0 ? c.scene.solver.diffusion_number * h * h / D : std::numeric_limits<double>::infinity();
+  rest_density_ = c.k.rest_density;
 
   if (deposit_) {
-    const double dx = scene.spacing, H = k.support;
+    const double dx = c.scene.spacing, H = c.k.support;
     params_.face = static_cast<float>(dx * dx);
     // The water weight sum_j M_j w(r / H) of a kernel volume kWetFraction full of water: rho0 kWetFraction
     // over the kernel's normalisation sigma / H^3 (Wendland C2 21 / (2 pi), the cubic spline 8 / pi).
     const double sigma3 =
-        scene.solver.kernel == KernelFunction::WendlandC2 ? 21.0 / (2.0 * M_PI) : 8.0 / M_PI;
-    params_.wet_weight = static_cast<float>(kWetFraction * k.rest_density * H * H * H / sigma3);
+        c.scene.solver.kernel == KernelFunction::WendlandC2 ? 21.0 / (2.0 * M_PI) : 8.0 / M_PI;
+    params_.wet_weight = static_cast<float>(kWetFraction * c.k.rest_density * H * H * H / sigma3);
     params_.cleanser = 0xffffu;
     for (std::size_t s = 0; s < count; ++s) {
-      const Substance& sub = scene.substances[s];
+      const Substance& sub = c.scene.substances[s];
       if (!sub.coating()) continue;
       params_.coating |= 1u << s;
       if (sub.cleanser >= 0) {
@@ -243,17 +242,17 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
       // Gamma_R,max) or of a deposit back (k_r c_D,max dt), c_max the largest concentration the scene starts
       // with or pours.
       auto most = [&](std::size_t of) {
-        double c = 0;
-        for (const FluidBlock& f : scene.fluids)
-          c = std::max(c, of < f.substances.size() ? f.substances[of] : 0.0);
-        for (const Emitter& e : scene.emitters)
-          c = std::max(c, of < e.substances.size() ? e.substances[of] : 0.0);
-        return c;
+        double top = 0;
+        for (const FluidBlock& f : c.scene.fluids)
+          top = std::max(top, of < f.substances.size() ? f.substances[of] : 0.0);
+        for (const Emitter& e : c.scene.emitters)
+          top = std::max(top, of < e.substances.size() ? e.substances[of] : 0.0);
+        return top;
       };
       double rate = sub.coating_rate / dx;
       if (sub.coating_capacity > 0) rate += sub.coating_rate * most(s) / sub.coating_capacity;
       if (sub.cleanser >= 0) rate += sub.cleansing_rate * most(static_cast<std::size_t>(sub.cleanser));
-      if (rate > 0) max_dt_ = std::min(max_dt_, scene.solver.diffusion_number / rate);
+      if (rate > 0) max_dt_ = std::min(max_dt_, c.scene.solver.diffusion_number / rate);
     }
   }
 
@@ -261,32 +260,33 @@ SubstanceStage::SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFi
   // Surface particles: more than a twentieth of a lattice face of area (kSurfaceMinArea; brackbill1992 gates
   // the area to the outer layer, where a flat face's particles carry 0.6 of theirs). The surface point of
   // each lies surface_depth_spacings out along its normal (substance_stage.h says why a quarter).
-  const double dx = scene.spacing;
+  const double dx = c.scene.spacing;
   params_.min_area = static_cast<float>(kSurfaceMinArea * dx * dx);
   params_.surface_depth = static_cast<float>(surface_depth_spacings * dx);
   // The 2-D kernel's normalisation over the support H: Wendland C2 7 / (pi H^2), the cubic spline
   // 40 / (7 pi H^2) (the 3-D ones' shapes, sph_lanes.h).
-  const double H = k.support;
-  const double sigma2 = scene.solver.kernel == KernelFunction::WendlandC2 ? 7.0 / M_PI : 40.0 / (7.0 * M_PI);
+  const double H = c.k.support;
+  const double sigma2 =
+      c.scene.solver.kernel == KernelFunction::WendlandC2 ? 7.0 / M_PI : 40.0 / (7.0 * M_PI);
   params_.sigma2 = static_cast<float>(sigma2);
   sigma2_over_h4_ = sigma2 / (H * H * H * H);
   for (std::size_t s = 0; s < count; ++s) {
-    const Substance& sub = scene.substances[s];
+    const Substance& sub = c.scene.substances[s];
     if (adsorbed_[s] < 0) continue;
     params_.surface |= 1u << s;
     // The most water a step may hand the surface or take back, as a fraction: k_d dt, k_a dt / dx (a
     // carrier of volume dx^3 under a face dx^2), and the Langmuir saturation rate k_a c / Gamma_max at the
     // largest concentration the scene starts with or pours, each at most diffusion_number.
     double c_max = 0;
-    for (const FluidBlock& f : scene.fluids)
+    for (const FluidBlock& f : c.scene.fluids)
       c_max = std::max(c_max, s < f.substances.size() ? f.substances[s] : 0.0);
-    for (const Emitter& e : scene.emitters)
+    for (const Emitter& e : c.scene.emitters)
       c_max = std::max(c_max, s < e.substances.size() ? e.substances[s] : 0.0);
     const double rate = sub.desorption_rate + sub.adsorption_rate / dx +
                         (sub.surface_capacity > 0 ? sub.adsorption_rate * c_max / sub.surface_capacity : 0.0);
-    if (rate > 0) max_dt_ = std::min(max_dt_, scene.solver.diffusion_number / rate);
+    if (rate > 0) max_dt_ = std::min(max_dt_, c.scene.solver.diffusion_number / rate);
     if (sub.surface_diffusivity > 0)
-      max_dt_ = std::min(max_dt_, scene.solver.diffusion_number * h * h / sub.surface_diffusivity);
+      max_dt_ = std::min(max_dt_, c.scene.solver.diffusion_number * h * h / sub.surface_diffusivity);
   }
 }
 

@@ -87,9 +87,7 @@ class SubstanceStage {
   // heat (then nothing melts or freezes, and neither the melt shift nor ice giving substances up is built).
   // `surface`: the surface stage's area and normal fields, which scenes with surface-active substances
   // need (substances_need_surface); null otherwise.
-  SubstanceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-                 const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout,
-                 const ParticleStore::Field* enthalpy, const SurfaceFields* surface);
+  SubstanceStage(const StageContext& c, const ParticleStore::Field* enthalpy, const SurfaceFields* surface);
 
   // The amount field of each of the scene's substances, in its order.
   const std::vector<ParticleStore::Field>& fields() const { return fields_; }

@@ -7,7 +7,7 @@
 #include "sim/cl_launch.h"
 #include "sim/kernels/sph_kernel.h"
 #include "sim/kernels/surface_params.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
 #include "sim/substance_stage.h"
 
 namespace thaw {
@@ -28,72 +28,70 @@ std::uint32_t nan_bits() { return std::bit_cast<std::uint32_t>(std::numeric_limi
 
 }  // namespace
 
-SurfaceStage::SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-                           const SolverConstants& k, const std::string& build_options,
-                           const ParticleLayout& layout)
-    : cl_(cl),
-      store_(store),
-      core_(core),
-      scene_(scene),
-      layout_(layout),
+SurfaceStage::SurfaceStage(const StageContext& c)
+    : cl_(c.cl),
+      store_(c.store),
+      core_(c.core),
+      scene_(c.scene),
+      layout_(c.layout),
       // heat.exposed_area's model; iwasaki2010 needs no stage, and surface-active substances then take the
       // default's areas.
-      model_(scene.heat.exposed_area == ExposedArea::Orthmann2013 ? ExposedArea::Orthmann2013
-                                                                  : ExposedArea::Brackbill1992) {
+      model_(c.scene.heat.exposed_area == ExposedArea::Orthmann2013 ? ExposedArea::Orthmann2013
+                                                                    : ExposedArea::Brackbill1992) {
   // Saved where the areas outlive a step (heat.area_interval > 1 in a flowing scene), so a resumed run
   // reads the areas the straight run had.
-  const bool outlive = scene.solver.flow && scene.heat.area_interval > 1;
-  area_ = store.add({"surface_area", FieldType::Float32, 1, outlive, true});
+  const bool outlive = c.scene.solver.flow && c.scene.heat.area_interval > 1;
+  area_ = c.store.add({"surface_area", FieldType::Float32, 1, outlive, true});
   // The normals too where surface-active substances read them (their points on the surface).
-  normal_ =
-      store.add({"surface_normal", FieldType::Float32, 4, outlive && substances_need_surface(scene), true});
+  normal_ = c.store.add(
+      {"surface_normal", FieldType::Float32, 4, outlive && substances_need_surface(c.scene), true});
   // Saved, so a resumed run relaxes from where it stopped; NaN (none yet) where a state has none.
-  delta_ = store.add({"surface_delta", FieldType::Float32, 1, true, false, nan_bits()});
+  delta_ = c.store.add({"surface_delta", FieldType::Float32, 1, true, false, nan_bits()});
 
-  const bool wendland = scene.solver.kernel == KernelFunction::WendlandC2;
+  const bool wendland = c.scene.solver.kernel == KernelFunction::WendlandC2;
   auto grad = wendland ? sph::wendland_c2_grad_factor : sph::cubic_spline_grad_factor;
 
-  std::string opts = build_options;
+  std::string opts = c.options;
   opts += model_ == ExposedArea::Orthmann2013 ? " -DTHAW_AREA_ORTHMANN2013" : " -DTHAW_AREA_BRACKBILL1992";
   for (int a = 0; a < 3; ++a)
-    if (scene.solver.periodic[static_cast<std::size_t>(a)])
+    if (c.scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
-  const auto program = cl.build(
+  const auto program = c.cl.build(
       {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h", "surface_params.h", "surface.cl"},
       opts);
   k_inside_ = cl::Kernel(program, "surface_inside");
   k_delta_ = cl::Kernel(program, "surface_delta");
-  const std::size_t padded = std::size_t(layout.stride) * 4;
-  inside_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
+  const std::size_t padded = std::size_t(c.layout.stride) * 4;
+  inside_ = cl::Buffer(c.cl.context(), CL_MEM_READ_WRITE, padded);
   if (model_ == ExposedArea::Orthmann2013) {
     k_area_ = cl::Kernel(program, "surface_area");
   } else {
     k_layer_ = cl::Kernel(program, "surface_layer");
     k_project_ = cl::Kernel(program, "surface_project");
     layer_n_ =
-        cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded * 3);  // the layer's normals: x, y, z blocks
-    cl.queue().enqueueFillBuffer(layer_n_, 0.0f, 0, padded * 3);
+        cl::Buffer(c.cl.context(), CL_MEM_READ_WRITE, padded * 3);  // the layer's normals: x, y, z blocks
+    c.cl.queue().enqueueFillBuffer(layer_n_, 0.0f, 0, padded * 3);
   }
-  delta_lanes_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, padded);
-  cl.queue().enqueueFillBuffer(delta_lanes_, 0.0f, 0, padded);
+  delta_lanes_ = cl::Buffer(c.cl.context(), CL_MEM_READ_WRITE, padded);
+  c.cl.queue().enqueueFillBuffer(delta_lanes_, 0.0f, 0, padded);
 
-  const double dx = scene.spacing;
-  params_.support = k.support;
+  const double dx = c.scene.spacing;
+  params_.support = c.k.support;
   params_.volume = static_cast<float>(dx * dx * dx);
   params_.radius = static_cast<float>(0.5 * dx);
   params_.spacing = static_cast<float>(dx);
   float* period[3] = {&params_.period_x, &params_.period_y, &params_.period_z};
   for (int a = 0; a < 3; ++a)
-    if (scene.solver.periodic[static_cast<std::size_t>(a)])
-      *period[a] = static_cast<float>(scene.domain.max[a] - scene.domain.min[a]);
-  params_.colour_scale = static_cast<float>(1.0 / sph::flat_face_colour_gradient(grad, dx, k.support));
-  params_.rim_scale = static_cast<float>(1.0 / sph::flat_edge_colour_gradient(grad, dx, k.support));
-  params_.min_neighbours = static_cast<float>(kSingularShare * sph::full_neighbourhood(dx, k.support));
+    if (c.scene.solver.periodic[static_cast<std::size_t>(a)])
+      *period[a] = static_cast<float>(c.scene.domain.max[a] - c.scene.domain.min[a]);
+  params_.colour_scale = static_cast<float>(1.0 / sph::flat_face_colour_gradient(grad, dx, c.k.support));
+  params_.rim_scale = static_cast<float>(1.0 / sph::flat_edge_colour_gradient(grad, dx, c.k.support));
+  params_.min_neighbours = static_cast<float>(kSingularShare * sph::full_neighbourhood(dx, c.k.support));
   params_.min_flatness = kMinFlatness;
   params_.rate = kSingularRate;
   // A neighbourhood with 0.9 of a resting lattice's colour lacks too few particles to be sparse or flat.
   params_.full_colour = static_cast<float>(
-      0.9 * sph::lattice_sum(wendland ? sph::wendland_c2_w : sph::cubic_spline_w, dx, k.support));
+      0.9 * sph::lattice_sum(wendland ? sph::wendland_c2_w : sph::cubic_spline_w, dx, c.k.support));
 }
 
 void SurfaceStage::run(const NeighbourView& nv) {

@@ -20,8 +20,7 @@ struct SolverConstants;
 
 class SurfaceStage {
  public:
-  SurfaceStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-               const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout);
+  SurfaceStage(const StageContext& c);
 
   ParticleStore::Field area() const { return area_; }
   ExposedArea model() const { return model_; }

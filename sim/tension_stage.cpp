@@ -5,7 +5,7 @@
 #include <numbers>
 
 #include "sim/cl_launch.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
 #include "sim/substance_stage.h"
 
 namespace thaw {
@@ -84,24 +84,23 @@ TensionCoefficients tension_coefficients(const Scene& scene, const SolverConstan
   return out;
 }
 
-TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-                           const SolverConstants& k, const std::string& build_options,
-                           const ParticleLayout& layout)
-    : cl_(cl), store_(store), core_(core), layout_(layout), model_(scene.tension.model) {
-  std::string opts = build_options + " -DTHAW_TENSION_";
-  for (const char* c = name(model_); *c; ++c) opts += static_cast<char>(std::toupper(*c));
+TensionStage::TensionStage(const StageContext& c)
+    : cl_(c.cl), store_(c.store), core_(c.core), layout_(c.layout), model_(c.scene.tension.model) {
+  std::string opts = c.options + " -DTHAW_TENSION_";
+  for (const char* ch = name(model_); *ch; ++ch) opts += static_cast<char>(std::toupper(*ch));
   const bool csf = model_ == TensionModel::Brackbill1992;
-  const double dx = scene.spacing;
+  const double dx = c.scene.spacing;
   // Cells are the support wide (grid_common.h): the fit's patch reaches this many of them.
   if (csf)
     opts += " -DTHAW_FIT_REACH=" +
-            std::to_string(static_cast<int>(std::ceil(tension::kFitRadius * dx / k.support)));
+            std::to_string(static_cast<int>(std::ceil(tension::kFitRadius * dx / c.k.support)));
   // Adhesion only where water can meet solids or ice.
-  if (!scene.walls.empty() || !scene.solids.empty() || !scene.ice.empty()) opts += " -DTHAW_TENSION_ADHESION";
-  lowered_ = substances_lower_tension(scene);
+  if (!c.scene.walls.empty() || !c.scene.solids.empty() || !c.scene.ice.empty())
+    opts += " -DTHAW_TENSION_ADHESION";
+  lowered_ = substances_lower_tension(c.scene);
   if (lowered_) opts += " -DTHAW_TENSION_LOWERED";
   const auto program =
-      cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "tension_params.h", "tension.cl"}, opts);
+      c.cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "tension_params.h", "tension.cl"}, opts);
   k_columns_ = cl::Kernel(program, "tension_columns");
   if (model_ == TensionModel::Akinci2013) k_normals_ = cl::Kernel(program, "tension_normals");
   if (csf) {
@@ -111,28 +110,28 @@ TensionStage::TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields
   }
   k_forces_ = cl::Kernel(program, "tension_forces");
 
-  const TensionCoefficients c = tension_coefficients(scene, k);
-  params_.support = k.support;
-  params_.rest_density = k.rest_density;
-  params_.cohesion = static_cast<float>(c.cohesion);
-  params_.curvature = scene.tension.curvature ? 1.0f : 0.0f;
-  params_.stride = layout.stride;
+  const TensionCoefficients tc = tension_coefficients(c.scene, c.k);
+  params_.support = c.k.support;
+  params_.rest_density = c.k.rest_density;
+  params_.cohesion = static_cast<float>(tc.cohesion);
+  params_.curvature = c.scene.tension.curvature ? 1.0f : 0.0f;
+  params_.stride = c.layout.stride;
   if (csf) {
-    params_.sigma = static_cast<float>(scene.tension.coefficient);
+    params_.sigma = static_cast<float>(c.scene.tension.coefficient);
     params_.volume = static_cast<float>(dx * dx * dx);
     params_.spacing = static_cast<float>(dx);
-    params_.layer_area = static_cast<float>(dx * dx * layer_density(dx, k.support));
+    params_.layer_area = static_cast<float>(dx * dx * layer_density(dx, c.k.support));
     params_.fit_radius = static_cast<float>(tension::kFitRadius * dx);
     params_.smooth_radius = static_cast<float>(tension::kSmoothRadius * dx);
   }
-  std::vector<float> adhesion = c.adhesion;
+  std::vector<float> adhesion = tc.adhesion;
   if (adhesion.empty()) adhesion.push_back(0.0f);
-  adhesion_ = cl::Buffer(cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+  adhesion_ = cl::Buffer(c.cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                          adhesion.size() * sizeof(float), adhesion.data());
   const std::size_t bytes =
-      std::size_t(layout.stride) * ((csf ? kCsfColumns : kColumns) + (lowered_ ? 1 : 0)) * sizeof(float);
-  columns_ = cl::Buffer(cl.context(), CL_MEM_READ_WRITE, bytes);
-  cl.queue().enqueueFillBuffer(columns_, 0.0f, 0, bytes);
+      std::size_t(c.layout.stride) * ((csf ? kCsfColumns : kColumns) + (lowered_ ? 1 : 0)) * sizeof(float);
+  columns_ = cl::Buffer(c.cl.context(), CL_MEM_READ_WRITE, bytes);
+  c.cl.queue().enqueueFillBuffer(columns_, 0.0f, 0, bytes);
 }
 
 void TensionStage::run(const NeighbourView& nv, const cl::Buffer& accel) {

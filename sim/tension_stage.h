@@ -45,8 +45,7 @@ TensionCoefficients tension_coefficients(const Scene& scene, const SolverConstan
 
 class TensionStage {
  public:
-  TensionStage(ClRuntime& cl, ParticleStore& store, const CoreFields& core, const Scene& scene,
-               const SolverConstants& k, const std::string& build_options, const ParticleLayout& layout);
+  TensionStage(const StageContext& c);
 
   // Adds the tension accelerations to `accel` (the forces pass's), from the densities of the last density
   // pass.

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "sim/emitters.h"
-#include "sim/solver.h"
+#include "sim/solver_constants.h"
 #include "sim/substance_stage.h"
 
 namespace thaw {
