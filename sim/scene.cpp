@@ -26,86 +26,13 @@ std::string format_number(double v) {
   return s.str();
 }
 
-const char* name(MaterialKind k) {
-  switch (k) {
-    case MaterialKind::Fluid:
-      return "fluid";
-    case MaterialKind::Solid:
-      return "solid";
-    case MaterialKind::Ice:
-      return "ice";
-    case MaterialKind::Air:
-      return "air";
-  }
-  return "?";
-}
-const char* name(Buoyancy b) {
-  switch (b) {
-    case Buoyancy::Boussinesq:
-      return "boussinesq";
-    case Buoyancy::IdealGas:
-      return "ideal_gas";
-    case Buoyancy::None:
-      break;
-  }
-  return "none";
-}
-const char* name(KernelFunction k) {
-  return k == KernelFunction::WendlandC2 ? "wendland_c2" : "cubic_spline";
-}
-const char* name(Eos e) { return e == Eos::Tait ? "tait" : "linear"; }
-const char* name(PressureSolver p) { return p == PressureSolver::Dfsph ? "dfsph" : "wcsph"; }
-const char* name(BoundaryVolume b) { return b == BoundaryVolume::Akinci2012 ? "akinci" : "lattice"; }
-const char* name(TensionLaw l) {
-  return l == TensionLaw::Szyszkowski ? "szyszkowski" : l == TensionLaw::Linear ? "linear" : "none";
-}
-
-const char* name(SubstanceKind k) {
-  return k == SubstanceKind::SurfaceActive ? "surface_active"
-         : k == SubstanceKind::Coating     ? "coating"
-                                           : "bulk";
-}
-const char* name(ExposedArea a) {
-  switch (a) {
-    case ExposedArea::Orthmann2013:
-      return "orthmann2013";
-    case ExposedArea::Brackbill1992:
-      return "brackbill1992";
-    case ExposedArea::Iwasaki2010:
-      break;
-  }
-  return "iwasaki2010";
-}
-const char* name(TensionModel m) {
-  switch (m) {
-    case TensionModel::Akinci2013:
-      return "akinci2013";
-    case TensionModel::Iwasaki2010:
-      return "iwasaki2010";
-    case TensionModel::Brackbill1992:
-      return "brackbill1992";
-    case TensionModel::None:
-      break;
-  }
-  return "none";
-}
-const char* name(DfsphBoundary b) { return b == DfsphBoundary::Akinci2012 ? "akinci2012" : "adami2012"; }
-const char* name(Multiphase m) {
-  return m == Multiphase::DomaradzkiMartyn ? "domaradzki_martyn" : "hu_adams2006";
-}
-const char* name(NoSlip n) { return n == NoSlip::Adami2012 ? "adami2012" : "none"; }
-const char* name(DryerModel m) { return m == DryerModel::Air ? "air" : "cone"; }
-const char* name(LiquidusLaw l) {
-  return l == LiquidusLaw::CrcNaCl ? "crc_nacl" : l == LiquidusLaw::Table ? "table" : "blagden";
-}
-
 namespace {
 // A choice the schema has already checked, as its enum.
-template <class E>
-E choice_of(const Json& value, std::initializer_list<E> options) {
+template <Choice E>
+E choice_of(const Json& value) {
   const std::string text = value.get<std::string>();
-  for (E e : options)
-    if (text == name(e)) return e;
+  for (const auto& [e, spelling] : Choices<E>::names)
+    if (text == spelling) return e;
   throw Error("'" + text + "' is not one of the choices (the schema should have refused it)");
 }
 }  // namespace
@@ -303,8 +230,7 @@ Box box_of(const Shape& shape) { return {shape.bounds().min(), shape.bounds().ma
 Material material_from_json(const std::string& name, const Json& m) {
   Material mat;
   mat.name = name;
-  mat.kind = choice_of<MaterialKind>(
-      m["kind"], {MaterialKind::Fluid, MaterialKind::Solid, MaterialKind::Ice, MaterialKind::Air});
+  mat.kind = choice_of<MaterialKind>(m["kind"]);
   mat.density = m["density"].get<double>();
   mat.viscosity = m["viscosity"].get<double>();
   mat.conductivity = m["conductivity"].get<double>();
@@ -321,9 +247,7 @@ HeatSettings heat_settings_from_json(const Json& doc) {
   h.enabled = doc["heat"]["enabled"].get<bool>();
   h.time_scale = doc["heat"]["time_scale"].get<double>();
   h.max_substeps = doc["heat"]["max_substeps"].get<int>();
-  h.exposed_area = choice_of<ExposedArea>(
-      doc["heat"]["exposed_area"],
-      {ExposedArea::Iwasaki2010, ExposedArea::Orthmann2013, ExposedArea::Brackbill1992});
+  h.exposed_area = choice_of<ExposedArea>(doc["heat"]["exposed_area"]);
   h.area_interval = doc["heat"]["area_interval"].get<int>();
   h.ambient_temperature = doc["ambient"]["temperature"].get<double>();
   h.ambient_coefficient = doc["ambient"]["heat_transfer_coefficient"].get<double>();
@@ -334,8 +258,7 @@ HeatSettings heat_settings_from_json(const Json& doc) {
 
 TensionSettings tension_settings_from_json(const Json& t) {
   TensionSettings s;
-  s.model = choice_of<TensionModel>(t["model"], {TensionModel::None, TensionModel::Akinci2013,
-                                                 TensionModel::Iwasaki2010, TensionModel::Brackbill1992});
+  s.model = choice_of<TensionModel>(t["model"]);
   s.coefficient = t["coefficient"].get<double>();
   s.curvature = t["curvature"].get<bool>();
   s.solid_contact_angle = t["solid_contact_angle"].get<double>();
@@ -369,8 +292,7 @@ void check_start(const Scene& s, int material, double T, const std::string& path
 // `solubility` may override), or the scene's own table, checked to rise and to stay a rising curve between
 // its points as liquidus.h interpolates it.
 void liquidus_from_json(Substance& sub, const Json& d, const std::string& path) {
-  sub.liquidus =
-      choice_of<LiquidusLaw>(d["liquidus"], {LiquidusLaw::Blagden, LiquidusLaw::CrcNaCl, LiquidusLaw::Table});
+  sub.liquidus = choice_of<LiquidusLaw>(d["liquidus"]);
   sub.solubility = d["solubility"].get<double>();
   if (sub.liquidus == LiquidusLaw::CrcNaCl) {
     sub.liquidus_points.assign(kCrcNaCl.begin(), kCrcNaCl.end());
@@ -478,8 +400,7 @@ AirFill air_fill_from_json(const Json& a, const Scene& s, const Json& materials)
     check_inside(s.domain, air.region, "air.region");
   }
   air.temperature = temperature_or(a, s.heat.ambient_temperature);
-  air.buoyancy =
-      choice_of<Buoyancy>(a["buoyancy"], {Buoyancy::None, Buoyancy::Boussinesq, Buoyancy::IdealGas});
+  air.buoyancy = choice_of<Buoyancy>(a["buoyancy"]);
   air.theta = a["theta"].get<double>();
   air.reference_temperature =
       a.contains("reference_temperature") ? a["reference_temperature"].get<double>() : air.temperature;
@@ -614,8 +535,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
     sub.dissociation = d["dissociation"].get<double>();
     liquidus_from_json(sub, d, "substances." + name);
     sub.enters_ice = d["enters_ice"].get<bool>();
-    sub.kind = choice_of<SubstanceKind>(
-        d["kind"], {SubstanceKind::Bulk, SubstanceKind::SurfaceActive, SubstanceKind::Coating});
+    sub.kind = choice_of<SubstanceKind>(d["kind"]);
     sub.colour = substance_colour(d["colour"].get<std::string>(), s.substances.size(),
                                   "substances." + name + ".colour");
     if (sub.surface_active()) {
@@ -623,8 +543,7 @@ Scene convert_and_check(Json doc, const std::string& folder) {
       sub.adsorption_rate = d["adsorption_rate"].get<double>();
       sub.desorption_rate = d["desorption_rate"].get<double>();
       sub.surface_capacity = d["surface_capacity"].get<double>();
-      sub.tension_law = choice_of<TensionLaw>(
-          d["tension_law"], {TensionLaw::None, TensionLaw::Szyszkowski, TensionLaw::Linear});
+      sub.tension_law = choice_of<TensionLaw>(d["tension_law"]);
       sub.tension_scale = d["tension_scale"].get<double>();
       if (sub.lowers_tension() && sub.surface_capacity <= 0 && s.tension.enabled())
         throw SceneError("substances." + name + ".tension_law",
@@ -880,7 +799,7 @@ Json to_json(const Lamp& l) {
 
 Dryer dryer_from_json(const Json& j, const std::string& path) {
   Dryer d;
-  d.model = choice_of<DryerModel>(j["model"], {DryerModel::Cone, DryerModel::Air});
+  d.model = choice_of<DryerModel>(j["model"]);
   d.on = j["on"].get<bool>();
   d.position = vec(j["position"]);
   d.direction = unit_direction(vec(j["direction"]), path + ".direction");
@@ -1104,29 +1023,25 @@ int wall_layer_count(const Scene& s) {
 
 SolverSettings solver_settings_from_json(const Json& j) {
   SolverSettings s;
-  s.kernel =
-      choice_of<KernelFunction>(j["kernel"], {KernelFunction::CubicSpline, KernelFunction::WendlandC2});
+  s.kernel = choice_of<KernelFunction>(j["kernel"]);
   s.support_ratio = j["support_ratio"].get<double>();
-  s.pressure = choice_of<PressureSolver>(j["pressure"], {PressureSolver::Wcsph, PressureSolver::Dfsph});
+  s.pressure = choice_of<PressureSolver>(j["pressure"]);
   s.density_tolerance = j["density_tolerance"].get<double>();
   s.divergence_tolerance = j["divergence_tolerance"].get<double>();
   s.max_pressure_iterations = j["max_pressure_iterations"].get<int>();
   s.pressure_relaxation = j["pressure_relaxation"].get<double>();
   s.divergence_warm_start = j["divergence_warm_start"].get<bool>();
-  s.boundary_pressure =
-      choice_of<DfsphBoundary>(j["boundary_pressure"], {DfsphBoundary::Adami2012, DfsphBoundary::Akinci2012});
-  s.multiphase =
-      choice_of<Multiphase>(j["multiphase"], {Multiphase::HuAdams2006, Multiphase::DomaradzkiMartyn});
-  s.eos = choice_of<Eos>(j["eos"], {Eos::Tait, Eos::Linear});
+  s.boundary_pressure = choice_of<DfsphBoundary>(j["boundary_pressure"]);
+  s.multiphase = choice_of<Multiphase>(j["multiphase"]);
+  s.eos = choice_of<Eos>(j["eos"]);
   s.gamma = j["gamma"].get<double>();
   s.speed_of_sound = j["speed_of_sound"].get<double>();
   s.sound_speed_factor = j["sound_speed_factor"].get<double>();
   s.reference_speed = j["reference_speed"].get<double>();
   s.artificial_viscosity = j["artificial_viscosity"].get<double>();
   s.boundary_viscosity = j["boundary_viscosity"].get<double>();
-  s.no_slip = choice_of<NoSlip>(j["no_slip"], {NoSlip::None, NoSlip::Adami2012});
-  s.boundary_volume =
-      choice_of<BoundaryVolume>(j["boundary_volume"], {BoundaryVolume::Lattice, BoundaryVolume::Akinci2012});
+  s.no_slip = choice_of<NoSlip>(j["no_slip"]);
+  s.boundary_volume = choice_of<BoundaryVolume>(j["boundary_volume"]);
   s.cfl = j["cfl"].get<double>();
   s.viscous_number = j["viscous_number"].get<double>();
   s.force_number = j["force_number"].get<double>();

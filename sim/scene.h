@@ -6,6 +6,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/geometry/shape.h"
@@ -24,8 +25,8 @@ struct Box {
   }
 };
 
-// Choices of the scene file as enums at the host boundary; the scene loader maps the file's spellings
-// (name() gives them back for messages and kernel build options).
+// Choices of the scene file as enums at the host boundary. Each one's spellings are in one table below
+// (Choices<E>), which the schema's choices, the scene loader and name() all read.
 // Air: a fluid of its own phase (Domaradzki & Martyn sec. 6.1): it flows, conducts and carries heat, and
 // never melts, freezes, exchanges heat with the ambient model or shows in the surface view.
 enum class MaterialKind { Fluid, Solid, Ice, Air };
@@ -53,25 +54,129 @@ enum class NoSlip { None, Adami2012 };
 // What a dryer is: an analytic cone of warm air that heats exposed ice and water (scenes without air
 // particles), or a nozzle that blows air particles (scenes with `air`; sim/emitters.h).
 enum class DryerModel { Cone, Air };
-const char* name(MaterialKind k);  // "fluid", "solid", "ice", "air"
 // Whether particles of this kind move with the fluid passes and carry their own mass (fluid and air).
 inline bool flows(MaterialKind k) { return k == MaterialKind::Fluid || k == MaterialKind::Air; }
-const char* name(KernelFunction k);  // "cubic_spline", "wendland_c2"
-const char* name(Eos e);             // "tait", "linear"
-const char* name(PressureSolver p);  // "wcsph", "dfsph"
-const char* name(BoundaryVolume b);  // "lattice", "akinci"
-const char* name(SubstanceKind k);   // "bulk", "surface_active", "coating"
-const char* name(TensionLaw l);      // "none", "szyszkowski", "linear"
-const char* name(ExposedArea a);     // "iwasaki2010", "orthmann2013", "brackbill1992"
-const char* name(DfsphBoundary b);   // "adami2012", "akinci2012"
-const char* name(Multiphase m);      // "hu_adams2006", "domaradzki_martyn"
-const char* name(NoSlip n);          // "none", "adami2012"
-const char* name(DryerModel m);      // "cone", "air"
-const char* name(TensionModel m);    // "none", "akinci2013", "iwasaki2010"
 // A substance's liquidus with water (sim/kernels/liquidus.h): Blagden's dilute law, NaCl's measured table
 // (CRC Handbook) to its eutectic, or the scene's own table.
 enum class LiquidusLaw { Blagden, CrcNaCl, Table };
-const char* name(LiquidusLaw l);  // "blagden", "crc_nacl", "table"
+
+// How air's density follows its temperature. Boussinesq: the momentum equation keeps the density rho0
+// except in the body force, rho0 g (1 - beta (T - T0)) (de Vahl Davis 1983's problem); the uniform part
+// rho0 g only makes the air's own hydrostatic pressure, a few pascals, and is left out, so the air feels
+// -beta (T - T0) g alone. IdealGas: Domaradzki & Martyn's eq 7, each air particle's rest density
+// rho0(T) = rho0(0 °C) / (1 + theta T) follows its temperature (with theta = 1/273.15 K, Charles's law:
+// the ideal gas at constant pressure) in the pressure solve's rest volumes (dfsph.cl), so warm air
+// expands, and it feels its weight less that of air at T0, g (1 - rho0(T0) / rho0(T)) (the reference
+// air's hydrostatic pressure left out as Boussinesq's is). None: air feels no gravity at all.
+enum class Buoyancy { None, Boussinesq, IdealGas };
+
+// Each choice's spellings in the scene file, in the order the schema lists them (the first is not always the
+// default: the schema says which is).
+template <class E>
+struct Choices;
+template <class E>
+concept Choice = requires {
+  Choices<E>::names;
+};
+
+template <>
+struct Choices<MaterialKind> {
+  static constexpr std::pair<MaterialKind, const char*> names[] = {{MaterialKind::Fluid, "fluid"},
+                                                                   {MaterialKind::Solid, "solid"},
+                                                                   {MaterialKind::Ice, "ice"},
+                                                                   {MaterialKind::Air, "air"}};
+};
+template <>
+struct Choices<KernelFunction> {
+  static constexpr std::pair<KernelFunction, const char*> names[] = {
+      {KernelFunction::CubicSpline, "cubic_spline"}, {KernelFunction::WendlandC2, "wendland_c2"}};
+};
+template <>
+struct Choices<Eos> {
+  static constexpr std::pair<Eos, const char*> names[] = {{Eos::Tait, "tait"}, {Eos::Linear, "linear"}};
+};
+template <>
+struct Choices<PressureSolver> {
+  static constexpr std::pair<PressureSolver, const char*> names[] = {{PressureSolver::Wcsph, "wcsph"},
+                                                                     {PressureSolver::Dfsph, "dfsph"}};
+};
+template <>
+struct Choices<BoundaryVolume> {
+  static constexpr std::pair<BoundaryVolume, const char*> names[] = {{BoundaryVolume::Lattice, "lattice"},
+                                                                     {BoundaryVolume::Akinci2012, "akinci"}};
+};
+template <>
+struct Choices<DfsphBoundary> {
+  static constexpr std::pair<DfsphBoundary, const char*> names[] = {
+      {DfsphBoundary::Adami2012, "adami2012"}, {DfsphBoundary::Akinci2012, "akinci2012"}};
+};
+template <>
+struct Choices<Multiphase> {
+  static constexpr std::pair<Multiphase, const char*> names[] = {
+      {Multiphase::HuAdams2006, "hu_adams2006"}, {Multiphase::DomaradzkiMartyn, "domaradzki_martyn"}};
+};
+template <>
+struct Choices<SubstanceKind> {
+  static constexpr std::pair<SubstanceKind, const char*> names[] = {
+      {SubstanceKind::Bulk, "bulk"},
+      {SubstanceKind::SurfaceActive, "surface_active"},
+      {SubstanceKind::Coating, "coating"}};
+};
+template <>
+struct Choices<TensionLaw> {
+  static constexpr std::pair<TensionLaw, const char*> names[] = {
+      {TensionLaw::Szyszkowski, "szyszkowski"}, {TensionLaw::Linear, "linear"}, {TensionLaw::None, "none"}};
+};
+template <>
+struct Choices<ExposedArea> {
+  static constexpr std::pair<ExposedArea, const char*> names[] = {
+      {ExposedArea::Iwasaki2010, "iwasaki2010"},
+      {ExposedArea::Brackbill1992, "brackbill1992"},
+      {ExposedArea::Orthmann2013, "orthmann2013"}};
+};
+template <>
+struct Choices<TensionModel> {
+  static constexpr std::pair<TensionModel, const char*> names[] = {
+      {TensionModel::None, "none"},
+      {TensionModel::Akinci2013, "akinci2013"},
+      {TensionModel::Iwasaki2010, "iwasaki2010"},
+      {TensionModel::Brackbill1992, "brackbill1992"}};
+};
+template <>
+struct Choices<NoSlip> {
+  static constexpr std::pair<NoSlip, const char*> names[] = {{NoSlip::None, "none"},
+                                                             {NoSlip::Adami2012, "adami2012"}};
+};
+template <>
+struct Choices<DryerModel> {
+  static constexpr std::pair<DryerModel, const char*> names[] = {{DryerModel::Cone, "cone"},
+                                                                 {DryerModel::Air, "air"}};
+};
+template <>
+struct Choices<LiquidusLaw> {
+  static constexpr std::pair<LiquidusLaw, const char*> names[] = {
+      {LiquidusLaw::Blagden, "blagden"}, {LiquidusLaw::CrcNaCl, "crc_nacl"}, {LiquidusLaw::Table, "table"}};
+};
+template <>
+struct Choices<Buoyancy> {
+  static constexpr std::pair<Buoyancy, const char*> names[] = {
+      {Buoyancy::Boussinesq, "boussinesq"}, {Buoyancy::IdealGas, "ideal_gas"}, {Buoyancy::None, "none"}};
+};
+
+// A choice's spelling ("wendland_c2"), for messages, kernel build options and the state a scene is saved in.
+template <Choice E>
+constexpr const char* name(E e) {
+  for (const auto& [value, spelling] : Choices<E>::names)
+    if (value == e) return spelling;
+  return "?";
+}
+// Every spelling of a choice, in the schema's order (the schema's list of it).
+template <Choice E>
+std::vector<std::string> choice_names() {
+  std::vector<std::string> out;
+  for (const auto& entry : Choices<E>::names) out.emplace_back(entry.second);
+  return out;
+}
 
 struct Material {
   std::string name;
@@ -93,17 +198,6 @@ struct Material {
   double held_temperature = 0.0;  // [°C]
   bool wall_heat = false;
 };
-
-// How air's density follows its temperature. Boussinesq: the momentum equation keeps the density rho0
-// except in the body force, rho0 g (1 - beta (T - T0)) (de Vahl Davis 1983's problem); the uniform part
-// rho0 g only makes the air's own hydrostatic pressure, a few pascals, and is left out, so the air feels
-// -beta (T - T0) g alone. IdealGas: Domaradzki & Martyn's eq 7, each air particle's rest density
-// rho0(T) = rho0(0 °C) / (1 + theta T) follows its temperature (with theta = 1/273.15 K, Charles's law:
-// the ideal gas at constant pressure) in the pressure solve's rest volumes (dfsph.cl), so warm air
-// expands, and it feels its weight less that of air at T0, g (1 - rho0(T0) / rho0(T)) (the reference
-// air's hydrostatic pressure left out as Boussinesq's is). None: air feels no gravity at all.
-enum class Buoyancy { None, Boussinesq, IdealGas };
-const char* name(Buoyancy b);  // "none", "boussinesq", "ideal_gas"
 
 // The scene's air particles (`air`): a region filled on the particle lattice with an air material,
 // except where fluid, ice or solids are.

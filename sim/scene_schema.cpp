@@ -11,12 +11,12 @@ const Field& solver_schema() {
   static const Field solver = object(
       "solver",
       {
-          choice("kernel", {"cubic_spline", "wendland_c2"}, "Smoothing kernel").def("cubic_spline"),
+          choice("kernel", choice_names<KernelFunction>(), "Smoothing kernel").def("cubic_spline"),
           number("support_ratio", "Kernel support radius / particle spacing")
               .def(2.0)
               .at_least(1.2)
               .at_most(4),
-          choice("pressure", {"wcsph", "dfsph"},
+          choice("pressure", choice_names<PressureSolver>(),
                  "Pressure solver: wcsph = weakly compressible, an equation of state (eos) and a sound-speed "
                  "time step; dfsph = divergence-free SPH (Bender & Koschier 2015, 2017), constant density by "
                  "iteration and a velocity time step")
@@ -49,14 +49,14 @@ const Field& solver_schema() {
               "flowing water, the same results (docs/BENCHMARKS.md)")
               .def(false),
           choice(
-              "boundary_pressure", {"adami2012", "akinci2012"},
+              "boundary_pressure", choice_names<DfsphBoundary>(),
               "dfsph: the pressure of wall, solid and ice particles in the solves: adami2012 = extrapolated "
               "from the fluid next to them each sweep (Adami et al. 2012), so a wall carries the full load; "
               "akinci2012 = none, the fluid's own pressure one-sided (Akinci et al. 2012, as Bender & "
               "Koschier 2017 use it), which carries half and lets water sink into walls (for comparison)")
               .def("adami2012"),
           choice(
-              "multiphase", {"hu_adams2006", "domaradzki_martyn"},
+              "multiphase", choice_names<Multiphase>(),
               "dfsph, fluids of several rest densities (air beside water): hu_adams2006 = each particle's "
               "density from its neighbours' rest volumes and a pair pressure weighted by the other's "
               "density (Hu & Adams 2006's inter-particle pressure), so the water's pressure does not push "
@@ -65,7 +65,7 @@ const Field& solver_schema() {
               "Martyn sec. 6.1): the pair's mean pressure, the viscosities' arithmetic mean (eq 5) and no "
               "suction at the interface (eq 6); meant for their air 10x lighter than water, for comparison")
               .def("hu_adams2006"),
-          choice("eos", {"tait", "linear"}, "Equation of state: Tait (stiff) or linear in density")
+          choice("eos", choice_names<Eos>(), "Equation of state: Tait (stiff) or linear in density")
               .def("tait"),
           number("gamma", "Tait exponent").def(7.0).at_least(1).at_most(10),
           number("speed_of_sound", "Numerical speed of sound; 0 = sound_speed_factor * reference_speed")
@@ -85,7 +85,7 @@ const Field& solver_schema() {
               .at_least(0)
               .at_most(1)
               .client_settable(),
-          choice("no_slip", {"none", "adami2012"},
+          choice("no_slip", choice_names<NoSlip>(),
                  "adami2012: walls, solids and ice hold the fluid still at their surface (Adami et al. 2012 "
                  "eqs 22-23: in the viscous term each boundary particle moves with 2 v_wall minus the fluid "
                  "velocity around it, with the fluid's own viscosity; boundary_viscosity is then unused); "
@@ -96,7 +96,7 @@ const Field& solver_schema() {
               .at_least(0)
               .at_most(1)
               .client_settable(),
-          choice("boundary_volume", {"lattice", "akinci"},
+          choice("boundary_volume", choice_names<BoundaryVolume>(),
                  "Volume of a boundary particle: lattice = spacing^3; akinci = 1 / sum_k W_bk (Akinci 2012 "
                  "eq 4)")
               .def("lattice"),
@@ -328,7 +328,7 @@ const Field& scene_schema() {
                       .def(1)
                       .at_least(1)
                       .at_most(64),
-                  choice("exposed_area", {"iwasaki2010", "brackbill1992", "orthmann2013"},
+                  choice("exposed_area", choice_names<ExposedArea>(),
                          "Model of each particle's surface exposed to air (the surface stage, "
                          "docs/SURFACE.md): brackbill1992 = the colour gradient's surface delta |grad c| "
                          "(Brackbill et al. 1992), scaled so a flat face sums to its area, with Orthmann et "
@@ -351,7 +351,7 @@ const Field& scene_schema() {
               "tension",
               {
                   choice(
-                      "model", {"none", "akinci2013", "iwasaki2010", "brackbill1992"},
+                      "model", choice_names<TensionModel>(),
                       "Interfacial tension of water (docs/TENSION.md): brackbill1992 = Brackbill, Kothe & "
                       "Zemach 1992's continuum surface force sigma kappa n on each surface particle's "
                       "area, kappa from a quadric fitted to the surface near it, with Akinci et al. 2013's "
@@ -457,7 +457,7 @@ const Field& scene_schema() {
                       .at_least(1)
                       .at_most(10),
                   choice(
-                      "liquidus", {"blagden", "crc_nacl", "table"},
+                      "liquidus", choice_names<LiquidusLaw>(),
                       "How far below the water's melting point a melt holding it freezes, by its mass "
                       "fraction (docs/SUBSTANCES.md): blagden, the dilute law from molar_mass and "
                       "dissociation, capped at 40 K, with no eutectic (it overestimates NaCl's freezing "
@@ -493,7 +493,7 @@ const Field& scene_schema() {
                        "layer of it. Empty: red, blue, green or amber by its place among the scene's "
                        "substances")
                       .def(""),
-                  choice("kind", {"bulk", "surface_active", "coating"},
+                  choice("kind", choice_names<SubstanceKind>(),
                          "bulk: it stays dissolved in the water; surface_active (a detergent): it also "
                          "gathers on the water's free surface, adsorbing from and desorbing to the water "
                          "under it and diffusing along the surface (Orthmann et al. 2013 sec. 5-6.2); "
@@ -501,7 +501,7 @@ const Field& scene_schema() {
                          "the water touches, and a cleanser takes it back (sec. 6.3-6.4)")
                       .def("bulk"),
                   choice(
-                      "tension_law", {"szyszkowski", "linear", "none"},
+                      "tension_law", choice_names<TensionLaw>(),
                       "How it lowers the water's surface tension where the surface holds it (where "
                       "tension.model is on): szyszkowski, sigma0 + E ln(1 - Gamma / Gamma_max) (Langmuir's "
                       "equation of state); linear, sigma0 - E Gamma / Gamma_max; none")
@@ -576,7 +576,7 @@ const Field& scene_schema() {
               .def(Json::object()),
           map_of("materials", "<name>",
                  {
-                     choice("kind", {"fluid", "solid", "ice", "air"},
+                     choice("kind", choice_names<MaterialKind>(),
                             "Fluid particles move; solids are static boundaries; ice is rigid (held where it "
                             "starts with motion fixed, a floating body with motion free) and melts into its "
                             "melts_into fluid; air is a gas that flows and carries heat (the `air` fill)"),
@@ -659,7 +659,7 @@ const Field& scene_schema() {
                       .above(-273.15)
                       .at_most(3000)
                       .optional(),
-                  choice("buoyancy", {"boussinesq", "ideal_gas", "none"},
+                  choice("buoyancy", choice_names<Buoyancy>(),
                          "boussinesq: warm air rises, feeling -beta (T - T0) g (its own weight is left to a "
                          "hydrostatic pressure of a few pascals); ideal_gas: Domaradzki & Martyn's eq 7, "
                          "each particle's rest density rho0 (1 + theta T0) / (1 + theta T) follows its "
@@ -811,7 +811,7 @@ const Field& scene_schema() {
           array_of(
               "dryers",
               {
-                  choice("model", {"cone", "air"},
+                  choice("model", choice_names<DryerModel>(),
                          "cone: an analytic cone of warm air heats the exposed ice and water inside it "
                          "(scenes without air particles); air: the nozzle blows air particles at `speed` "
                          "and `temperature` and draws in the air behind it (scenes with `air`)")
