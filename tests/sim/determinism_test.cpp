@@ -1,5 +1,5 @@
 // The same run gives the same bits (issue 44): every shipped scene and every validation case, run twice from
-// the start, leaves byte-identical states; the conservation case passes twenty times over with the same
+// the start, leaves byte-identical states; the conservation case passes five times over with the same
 // metrics; and where two runs differ, RunDigest says at which step, stage and state section.
 #include <gtest/gtest.h>
 
@@ -149,12 +149,13 @@ TEST_F(DeterminismTest, EveryValidationCaseGivesTheSameBitsTwice) {
 }
 
 // The case CI once failed at random (melted 0 of 64 ice particles): it indexed its phase record by particle
-// id past the record's end once the tap's ids outgrew the particle count. Every run now passes with the same
-// metrics, to the bit.
-TEST_F(DeterminismTest, TheConservationCasePassesTwentyTimesWithTheSameMetrics) {
+// id past the record's end once the tap's ids outgrew the particle count (a read past the end: it failed about
+// one run in ten). Five runs pass with the same metrics, to the bit; more are a sweep for `thaw validate
+// conservation --twice` in a loop, not for every CI run.
+TEST_F(DeterminismTest, TheConservationCasePassesFiveTimesWithTheSameMetrics) {
   const CaseResult first = run_validation(cl(), "conservation", 4, {});
   testing::expect_case_passes(first);
-  for (int k = 1; k < 20; ++k) {
+  for (int k = 1; k < 5; ++k) {
     const CaseResult again = run_validation(cl(), "conservation", 4, {});
     ASSERT_TRUE(again.passed()) << "run " << k;
     ASSERT_EQ(again.metrics.size(), first.metrics.size());
