@@ -49,9 +49,8 @@ DfsphStage::DfsphStage(const StageContext& c, const cl::Buffer& flow, bool with_
   // The density solve's target: the density a resting lattice sums to (dfsph.cl, dfsph_error).
   relaxation << " -DTHAW_DFSPH_LATTICE=" << dfsph_rest_ratio(c.scene) << "f";
   if (ideal_gas_) relaxation << " -DTHAW_IDEAL_GAS";
-  const auto program = c.cl.build(
-      {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h", "dfsph_columns.h", "dfsph.cl"},
-      relaxation.str());
+  const auto program =
+      c.cl.build(neighbour_program({"fluid_params.h", "dfsph_columns.h", "dfsph.cl"}), relaxation.str());
   k_columns_ = cl::Kernel(program, "dfsph_columns");
   // A closed domain's air cannot leave as it warms: the domain's pressure rises instead, so that eq 7's
   // density at that pressure, P / (R T), keeps the air's volume (the thermodynamic pressure of a closed

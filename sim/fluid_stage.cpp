@@ -99,26 +99,23 @@ FluidStage::FluidStage(const StageContext& c, bool with_heat)
       f_(c.core),
       layout_(c.layout),
       buoyancy_(buoyancy_reads_temperature(c.scene, with_heat)) {
-  const std::vector<std::string> prelude = {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h"};
-  auto with = [&](std::initializer_list<std::string> files) {
-    std::vector<std::string> all = prelude;
-    all.insert(all.end(), files);
-    return all;
-  };
   no_slip_ = c.scene.solver.no_slip == NoSlip::Adami2012;
   const std::string slip = no_slip_ ? " -DTHAW_NO_SLIP" : "";
-  k_density_ = cl::Kernel(c.cl.build(with({"dfsph_columns.h", "density.cl"}), c.options + slip), "density");
-  k_forces_ = cl::Kernel(
-      c.cl.build(with({"forces.cl"}), c.options + slip + (buoyancy_ ? " -DTHAW_BUOYANCY" : "")), "forces");
-  const auto integrate = c.cl.build(with({"integrate.cl", "step_limits.cl"}), c.options);
+  k_density_ = cl::Kernel(
+      c.cl.build(neighbour_program({"fluid_params.h", "dfsph_columns.h", "density.cl"}), c.options + slip),
+      "density");
+  k_forces_ = cl::Kernel(c.cl.build(neighbour_program({"fluid_params.h", "forces.cl"}),
+                                    c.options + slip + (buoyancy_ ? " -DTHAW_BUOYANCY" : "")),
+                         "forces");
+  const auto integrate =
+      c.cl.build(neighbour_program({"fluid_params.h", "integrate.cl", "step_limits.cl"}), c.options);
   k_limits_ = cl::Kernel(integrate, "step_limits");
   k_integrate_ = cl::Kernel(integrate, "integrate");
 
   const std::vector<fluid::MaterialFlow> table = material_flow_table(c.scene, c.k, with_heat);
   auto& ctx = c.cl.context();
-  flow_ =
-      cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(fluid::MaterialFlow),
-                   const_cast<fluid::MaterialFlow*>(table.data()));
+  flow_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(fluid::MaterialFlow),
+                     const_cast<fluid::MaterialFlow*>(table.data()));
   const std::size_t n = std::max<std::size_t>(c.layout.capacity, 1);
   const std::size_t tiles = std::max<cl_uint>(c.layout.max_tiles, 1);
   auto buf = [&](std::size_t bytes) {

@@ -43,9 +43,9 @@ HeatStage::HeatStage(const StageContext& c, const HeatPlan& plan, const Eigen::V
   for (int a = 0; a < 3; ++a)
     if (c.scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
-  const auto program = c.cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h",
-                                   "dryer_model.h", "heat_params.h", "wrapped_walk.h", "heat.cl"},
-                                  opts);
+  const auto program = c.cl.build(
+      neighbour_program({"thermal_law.h", "dryer_model.h", "heat_params.h", "wrapped_walk.h", "heat.cl"}),
+      opts);
   k_thermal_state_ = cl::Kernel(program, "thermal_state");
   k_heat_ = cl::Kernel(program, "heat");
   k_absorb_ = cl::Kernel(program, "absorb_photons");
@@ -60,9 +60,8 @@ HeatStage::HeatStage(const StageContext& c, const HeatPlan& plan, const Eigen::V
     return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, 4));
   };
   const std::vector<MaterialThermal> table = material_thermal_table(c.scene, c.k.rest_density);
-  materials_ =
-      cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, table.size() * sizeof(MaterialThermal),
-                   const_cast<MaterialThermal*>(table.data()));
+  materials_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                          table.size() * sizeof(MaterialThermal), const_cast<MaterialThermal*>(table.data()));
   thermal_ = buf(std::size_t(c.layout.stride) * 3 * 4);
   q.enqueueFillBuffer(thermal_, 0.0f, 0, std::size_t(c.layout.stride) * 3 * 4);
   if (plan.lamps) {

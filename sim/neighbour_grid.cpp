@@ -70,7 +70,7 @@ NeighbourGrid::NeighbourGrid(ClRuntime& cl, const Scene& scene, float support, i
   radix_bits_ = static_cast<std::uint32_t>((bits + int(sort_passes_) - 1) / int(sort_passes_));
 
   const bool room_air = EmitterStage::admits_room_air(scene);
-  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "grid.cl"},
+  const auto program = cl.build(neighbour_program({"grid.cl"}),
                                 build_options + " -DTHAW_RADIX_BITS=" + std::to_string(radix_bits_) +
                                     " -DTHAW_SCAN_CHUNK=" + std::to_string(kScanChunk) +
                                     (intake_ ? " -DTHAW_INTAKE" : "") + (room_air ? " -DTHAW_ROOM_AIR" : ""));

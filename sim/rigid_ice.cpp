@@ -7,6 +7,7 @@
 
 #include "sim/cl_launch.h"
 #include "sim/error.h"
+#include "sim/stage.h"
 
 namespace thaw {
 namespace {
@@ -84,9 +85,9 @@ RigidIce::RigidIce(ClRuntime& cl, ParticleStore& store, const std::string& build
       settings_(std::move(settings)),
       anchored_by_id_(std::move(anchored_by_id)),
       mass_scale_(std::move(mass_scale)) {
-  const auto program = cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "fluid_params.h",
-                                 "dfsph_columns.h", "tension_params.h", "rigid.cl"},
-                                build_options);
+  const auto program =
+      cl.build(neighbour_program({"fluid_params.h", "dfsph_columns.h", "tension_params.h", "rigid.cl"}),
+               build_options);
   k_forces_ = cl::Kernel(program, "rigid_forces");
   k_place_ = cl::Kernel(program, "rigid_place");
   labeller_ = std::make_unique<IceLabeller>(cl, settings_.grid_reach);

@@ -31,14 +31,6 @@ constexpr int kGridReach = 1;
 // width) beat 4 and 16 on the AVX-512 machine of docs/BENCHMARKS.md.
 constexpr int kLanes = 8;
 
-const std::vector<std::string> kPrelude = {"sph_kernel.h", "grid_common.h", "sph_lanes.h"};
-
-std::vector<std::string> with_prelude(std::initializer_list<std::string> files) {
-  std::vector<std::string> all = kPrelude;
-  all.insert(all.end(), files);
-  return all;
-}
-
 std::vector<float> rigid_mass_scales(const Scene& scene, double rest_density) {
   std::vector<float> out;
   for (const Material& m : scene.materials) out.push_back(static_cast<float>(mass_scale(m, rest_density)));
@@ -437,7 +429,7 @@ void Solver::emit(double dt) {
 
 void Solver::compute_boundary_psi(const std::string& opts) {
   // Once, at the start, and only for scenes that ask for Akinci's volumes: built here, not kept.
-  const auto boundary = cl_.build(with_prelude({"boundary.cl"}), opts);
+  const auto boundary = cl_.build(neighbour_program({"boundary.cl"}), opts);
   cl::Kernel psi(boundary, "boundary_psi"), set_mass(boundary, "set_mass");
   cl::Buffer scratch(cl_.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(n_, 1) * 4);
   build_grid(false);

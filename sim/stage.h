@@ -7,6 +7,9 @@
 #include <CL/opencl.hpp>
 #include <algorithm>
 #include <cstddef>
+#include <initializer_list>
+#include <string>
+#include <vector>
 
 #include "sim/cl_grid.h"
 #include "sim/particle_store.h"
@@ -74,6 +77,14 @@ inline CoreFields add_core_fields(ParticleStore& store) {
     if (spec.name == "id") f.id = h;
   }
   return f;
+}
+
+// A neighbour pass's program: the headers every one starts with (sim/kernels/: the smoothing kernel, the grid
+// and its walk, the SIMD lanes and the pair geometry of walk.h), then `files`.
+inline std::vector<std::string> neighbour_program(std::initializer_list<std::string> files) {
+  std::vector<std::string> all = {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "walk.h"};
+  all.insert(all.end(), files);
+  return all;
 }
 
 // What every stage is built from: the run's device, its particle store and core fields, the scene and the

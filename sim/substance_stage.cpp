@@ -163,8 +163,8 @@ SubstanceStage::SubstanceStage(const StageContext& c, const ParticleStore::Field
   for (int a = 0; a < 3; ++a)
     if (c.scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
-  const auto program = c.cl.build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h",
-                                   "thermal_law.h", "liquidus.h", "substance_params.h", "substance.cl"},
+  const auto program = c.cl.build(neighbour_program({"wrapped_walk.h", "thermal_law.h", "liquidus.h",
+                                                     "substance_params.h", "substance.cl"}),
                                   opts);
   k_state_ = cl::Kernel(program, "substance_state");
   if (ice_pass_) k_ice_ = cl::Kernel(program, "substance_ice");
@@ -202,7 +202,7 @@ SubstanceStage::SubstanceStage(const StageContext& c, const ParticleStore::Field
   law_ = cl::Buffer(c.cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, law.size() * 4, law.data());
   liquidus_table_ = liquidus_table(c.scene);  // each substance's phase diagram
   liquidus_ = cl::Buffer(c.cl.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                           liquidus_table_.size() * sizeof(thermal::Liquidus), liquidus_table_.data());
+                         liquidus_table_.size() * sizeof(thermal::Liquidus), liquidus_table_.data());
 
   params_.support = c.k.support;
   params_.eta2 = 0.01f * c.k.smoothing * c.k.smoothing;

@@ -56,9 +56,8 @@ SurfaceStage::SurfaceStage(const StageContext& c)
   for (int a = 0; a < 3; ++a)
     if (c.scene.solver.periodic[static_cast<std::size_t>(a)])
       opts += std::string(" -DTHAW_PERIODIC_") + "XYZ"[a];
-  const auto program = c.cl.build(
-      {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h", "surface_params.h", "surface.cl"},
-      opts);
+  const auto program =
+      c.cl.build(neighbour_program({"wrapped_walk.h", "surface_params.h", "surface.cl"}), opts);
   k_inside_ = cl::Kernel(program, "surface_inside");
   k_delta_ = cl::Kernel(program, "surface_delta");
   const std::size_t padded = std::size_t(c.layout.stride) * 4;

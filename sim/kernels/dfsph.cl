@@ -71,23 +71,6 @@
 #define THAW_DFSPH_LATTICE 1.0f
 #endif
 
-/* The reorder's structure-of-arrays copy: positions and masses, blocks of `stride` floats. */
-#define DFSPH_SOA(soa, stride)                  \
-  global const float* X = (soa);                \
-  global const float* Y = (soa) + (stride);     \
-  global const float* Z = (soa) + 2 * (stride); \
-  global const float* M = (soa) + 3 * (stride);
-
-/* Inside FOR_EACH_NEIGHBOUR_ROW's loop over candidates j..: the lanes' offsets x_ij (dx, dy, dz), r²
- * and which lanes are real neighbours (`in`), from the soa positions X, Y, Z; the three passes below
- * share it. */
-#define DFSPH_LANES(pi, j, je, H2)                                      \
-  const floatV dx = (pi).x - vloadV(0, X + (j));                        \
-  const floatV dy = (pi).y - vloadV(0, Y + (j));                        \
-  const floatV dz = (pi).z - vloadV(0, Z + (j));                        \
-  const floatV r2 = dx * dx + dy * dy + dz * dz;                        \
-  const intV in = (THAW_LANE_IDS < (int)((je) - (j))) & (r2 < (H2));
-
 /* FM: who is fluid, as the lanes of the other passes (and the density pass's alpha) read it; run after the
  * grid's sort, before the density pass. */
 #ifdef THAW_IDEAL_GAS
@@ -161,7 +144,7 @@ float density_rate(const float4 pi, const float3 vi, global const float* soa, gl
                    global const uint* cell_start, const Grid g, const float H, const uint stride, const int heavy) {
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
-  DFSPH_SOA(soa, stride)
+  const Positions xs = soa_positions(soa, stride);
   global const float* VX = soa + 4 * stride;
   global const float* VY = soa + 5 * stride;
   global const float* VZ = soa + 6 * stride;
@@ -169,9 +152,9 @@ float density_rate(const float4 pi, const float3 vi, global const float* soa, gl
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      DFSPH_LANES(pr, j, je, H2)
-      const floatV vd = (vi.x - vloadV(0, VX + j)) * dx + (vi.y - vloadV(0, VY + j)) * dy +
-                        (vi.z - vloadV(0, VZ + j)) * dz;
+      const Pair q = pair_lanes(xs, pr, j, je, H2);
+      const floatV vd = (vi.x - vloadV(0, VX + j)) * q.dx + (vi.y - vloadV(0, VY + j)) * q.dy +
+                        (vi.z - vloadV(0, VZ + j)) * q.dz;
 #ifdef THAW_MULTIPHASE
       const floatV vj = vloadV(0, col + COL_VOL * stride + j);
       intV skip = (intV)(0);
@@ -179,9 +162,9 @@ float density_rate(const float4 pi, const float3 vi, global const float* soa, gl
         const floatV fmj = vloadV(0, col + COL_FM * stride + j);
         skip = (fmj > 0.0f) & (fmj * THAW_MP_SPLIT > vj); /* rho0_j = V_j / FM_j < split */
       }
-      acc += select((floatV)(0.0f), vj * grad_shape(sqrt(r2) * inv_H) * vd, in & ~skip);
+      acc += select((floatV)(0.0f), vj * grad_shape(sqrt(q.r2) * inv_H) * vd, q.in & ~skip);
 #else
-      acc += select((floatV)(0.0f), vloadV(0, M + j) * grad_shape(sqrt(r2) * inv_H) * vd, in);
+      acc += select((floatV)(0.0f), vloadV(0, xs.m + j) * grad_shape(sqrt(q.r2) * inv_H) * vd, q.in);
 #endif
     }
   }
@@ -265,33 +248,33 @@ kernel void dfsph_extrapolate(global const float4* pos, global const float* soa,
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
-  DFSPH_SOA(soa, stride)
+  const Positions xs = soa_positions(soa, stride);
   global const float* FM = col + COL_FM * stride;
   global const float* KR = col + COL_KR * stride;
   floatV num = (floatV)(0.0f), den = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      DFSPH_LANES(pr, j, je, H2)
+      const Pair q = pair_lanes(xs, pr, j, je, H2);
 #ifdef THAW_MULTIPHASE
       /* Shepard weights V_f W_bf over the heavy fluid only, KR the pressure itself: the light fluid
        * (air) takes its own pressure for a wall's (dfsph_correct), and the water's wall pressure is not
        * lowered by the air's beside it. rho0_j = V_j / FM_j. */
       const floatV vj = vloadV(0, col + COL_VOL * stride + j), fmj = vloadV(0, FM + j);
       const floatV w = select((floatV)(0.0f), vj, (fmj > 0.0f) & (fmj * THAW_MP_SPLIT <= vj)) *
-                       w_shape(sqrt(r2) * inv_H);
+                       w_shape(sqrt(q.r2) * inv_H);
       const floatV rho_j = vloadV(0, density + j);
       floatV p = vloadV(0, KR + j);
-      if (hydrostatic) p += rho_j * (gravity.x * dx + gravity.y * dy + gravity.z * dz);
-      num += select((floatV)(0.0f), w * p, in);
-      den += select((floatV)(0.0f), w, in);
+      if (hydrostatic) p += rho_j * (gravity.x * q.dx + gravity.y * q.dy + gravity.z * q.dz);
+      num += select((floatV)(0.0f), w * p, q.in);
+      den += select((floatV)(0.0f), w, q.in);
 #else
-      const floatV w = vloadV(0, FM + j) * w_shape(sqrt(r2) * inv_H); /* 0 for boundary neighbours */
+      const floatV w = vloadV(0, FM + j) * w_shape(sqrt(q.r2) * inv_H); /* 0 for boundary neighbours */
       const floatV rho_j = vloadV(0, density + j);
       floatV p = vloadV(0, KR + j) * rho_j * rho_j;
-      if (hydrostatic) p += rho_j * (gravity.x * dx + gravity.y * dy + gravity.z * dz);
-      num += select((floatV)(0.0f), w * p, in);
-      den += select((floatV)(0.0f), w, in);
+      if (hydrostatic) p += rho_j * (gravity.x * q.dx + gravity.y * q.dy + gravity.z * q.dz);
+      num += select((floatV)(0.0f), w * p, q.in);
+      den += select((floatV)(0.0f), w, q.in);
 #endif
     }
   }
@@ -369,7 +352,7 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H, inv_H = 1.0f / H;
-  DFSPH_SOA(soa, stride)
+  const Positions xs = soa_positions(soa, stride);
 #ifdef THAW_MULTIPHASE
   global const float* FM = col + COL_FM * stride;
   const float rho0_i = pi.w / col[COL_VOL * stride + i];
@@ -384,7 +367,7 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      DFSPH_LANES(pr, j, je, H2)
+      const Pair q = pair_lanes(xs, pr, j, je, H2);
 #ifdef THAW_MULTIPHASE
       /* The pair's pressure weighted by the other's rest density (Hu & Adams 2006's inter-particle pressure):
        * 2 p_ij = c_ij pi_i + (2 - c_ij) pi_j, c_ij = 2 rho0_j / (rho0_i + rho0_j); between fluids of one
@@ -398,13 +381,13 @@ kernel void dfsph_correct(global float4* vel, global float* soa, global const uc
 #endif
       const floatV krj = vloadV(0, KR + j);
       const floatV pj = light_i ? select((floatV)(kri), krj, fmj > 0.0f) : krj;
-      const floatV t = vj * (cw * kri + (2.0f - cw) * pj) * grad_shape(sqrt(r2) * inv_H);
+      const floatV t = vj * (cw * kri + (2.0f - cw) * pj) * grad_shape(sqrt(q.r2) * inv_H);
 #else
-      const floatV t = vloadV(0, M + j) * (kri + vloadV(0, KR + j)) * grad_shape(sqrt(r2) * inv_H);
+      const floatV t = vloadV(0, xs.m + j) * (kri + vloadV(0, KR + j)) * grad_shape(sqrt(q.r2) * inv_H);
 #endif
-      ax += select((floatV)(0.0f), t * dx, in);
-      ay += select((floatV)(0.0f), t * dy, in);
-      az += select((floatV)(0.0f), t * dz, in);
+      ax += select((floatV)(0.0f), t * q.dx, q.in);
+      ay += select((floatV)(0.0f), t * q.dy, q.in);
+      az += select((floatV)(0.0f), t * q.dz, q.in);
     }
   }
 #ifdef THAW_MULTIPHASE

@@ -55,22 +55,6 @@ kernel void thermal_state(global const float4* pos, global const float* density,
   thermal[2 * stride + i] = pos[i].w / rho;
 }
 
-/* The neighbour loops' structure-of-arrays inputs: the reorder's positions and thermal_state's T, k, V. */
-#define HEAT_SOA(soa, thermal, stride)            \
-  global const float* X = (soa);                  \
-  global const float* Y = (soa) + (stride);       \
-  global const float* Z = (soa) + 2 * (stride);   \
-  global const float* TT = (thermal);             \
-  global const float* KK = (thermal) + (stride);  \
-  global const float* VV = (thermal) + 2 * (stride);
-
-/* Inside a loop over candidates j..: the lanes' minimum-image offsets x_ij (dx, dy, dz) and r^2. */
-#define HEAT_LANES(pi, j, period)                                          \
-  const floatV dx = THAW_WRAP((pi).x - vloadV(0, X + (j)), (period).x); \
-  const floatV dy = THAW_WRAP((pi).y - vloadV(0, Y + (j)), (period).y); \
-  const floatV dz = THAW_WRAP((pi).z - vloadV(0, Z + (j)), (period).z); \
-  const floatV r2 = dx * dx + dy * dy + dz * dz;
-
 #ifdef THAW_ADIABATIC
 /* Adiabatic solids (materials' `adiabatic`): each particle takes the temperature and conductivity of the
  * fluid and ice around it, their Shepard average sum_j V_j W_ij X_j / sum_j V_j W_ij over non-solid
@@ -92,14 +76,18 @@ kernel void adiabatic_state(global const float4* pos, global const uchar* phase,
   const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
   const float4 pi = pos[i];
   const int4 c = grid_cell(g, pi);
-  HEAT_SOA(soa, thermal, stride)
+  const Positions xs = soa_positions(soa, stride);
+  /* thermal_state's blocks: each particle's T, k and V */
+  global const float* TT = thermal;
+  global const float* KK = thermal + stride;
+  global const float* VV = thermal + 2 * stride;
   floatV st = (floatV)(0.0f), sk = (floatV)(0.0f), sw = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      HEAT_LANES(pi, j, period)
+      const Pair o = pair_lanes_wrapped(xs, pi, period, j, je, H2);
       const intV ph = THAW_CAT(convert_int, THAW_VW)(THAW_CAT(vload, THAW_VW)(0, phase + j));
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2) & (ph != THAW_PHASE_SOLID);
-      const floatV w = select((floatV)(0.0f), vloadV(0, VV + j) * w_shape(sqrt(r2) * inv_H), in);
+      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (o.r2 < H2) & (ph != THAW_PHASE_SOLID);
+      const floatV w = select((floatV)(0.0f), vloadV(0, VV + j) * w_shape(sqrt(o.r2) * inv_H), in);
       st += w * select((floatV)(0.0f), vloadV(0, TT + j), in);
       sk += w * select((floatV)(0.0f), vloadV(0, KK + j), in);
       sw += w;
@@ -162,7 +150,11 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
   const int4 c = grid_cell(g, pi);
   const float H2 = H * H;
   const float inv_H = 1.0f / H;
-  HEAT_SOA(soa, thermal, stride)
+  const Positions xs = soa_positions(soa, stride);
+  /* thermal_state's blocks: each particle's T, k and V */
+  global const float* TT = thermal;
+  global const float* KK = thermal + stride;
+  global const float* VV = thermal + 2 * stride;
   const float Ti = TT[i];
 #ifdef THAW_ADIABATIC
   /* Adiabatic particles (k < 0, adiabatic_state) pair with fluid and ice only. */
@@ -175,24 +167,25 @@ kernel void heat(global float4* pos, global float4* vel, global float2* enthalpy
   intV covered = (intV)(0);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      HEAT_LANES(pi, j, period)
+      const Pair o = pair_lanes_wrapped(xs, pi, period, j, je, H2);
       const intV lane = THAW_LANE_IDS < (int)(je - j);
 #ifdef THAW_ADIABATIC
       const floatV kraw = vloadV(0, KK + j);
       const floatV kj = fabs(kraw);
       const intV solid_j = THAW_CAT(convert_int, THAW_VW)(THAW_CAT(vload, THAW_VW)(0, phase + j)) == THAW_PHASE_SOLID;
-      const intV in = lane & (r2 < H2) & ~((i_adiabatic ? solid_j : (intV)(0)) | (i_solid ? (kraw < 0.0f) : (intV)(0)));
+      const intV in =
+          lane & (o.r2 < H2) & ~((i_adiabatic ? solid_j : (intV)(0)) | (i_solid ? (kraw < 0.0f) : (intV)(0)));
 #else
-      const intV in = lane & (r2 < H2);
+      const intV in = lane & (o.r2 < H2);
       const floatV kj = vloadV(0, KK + j);
 #endif
       /* Harmonic mean; two insulators (k = 0) exchange nothing. */
       const floatV kij = 2.0f * ki * kj / fmax(ki + kj, 1e-30f);
-      const floatV term = vloadV(0, VV + j) * kij * (Ti - vloadV(0, TT + j)) * grad_shape(sqrt(r2) * inv_H) *
-                          r2 / (r2 + eta2);
+      const floatV term = vloadV(0, VV + j) * kij * (Ti - vloadV(0, TT + j)) *
+                          grad_shape(sqrt(o.r2) * inv_H) * o.r2 / (o.r2 + eta2);
       acc += select((floatV)(0.0f), term, in);
 #if (defined(THAW_AMBIENT) || defined(THAW_DRYERS)) && !defined(THAW_SURFACE_AREA)
-      covered += select((intV)(0), (intV)(1), lane & (r2 < exposed_r2));
+      covered += select((intV)(0), (intV)(1), lane & (o.r2 < exposed_r2));
 #endif
     }
   }

@@ -128,25 +128,16 @@ float2 lanes_compensated(floatV hi, floatV lo) {
   return (float2)(s, e);
 }
 
-/* Inside a walk over candidates j..: the lanes' squared distance r2 from pi, along periodic axes the minimum
- * image's (X, Y, Z: the reorder's position blocks). The same operations on both sides of every pair. */
-#define PAIR_LANES(pi, j, period)                                          \
-  const floatV dx = THAW_WRAP((pi).x - vloadV(0, X + (j)), (period).x); \
-  const floatV dy = THAW_WRAP((pi).y - vloadV(0, Y + (j)), (period).y); \
-  const floatV dz = THAW_WRAP((pi).z - vloadV(0, Z + (j)), (period).z); \
+/* Inside a walk over candidates j..: the lanes' offsets and squared distance r2 from pi, along periodic axes
+ * the minimum image's (xs: walk.h's positions). The same operations on both sides of every pair. Still a
+ * macro here, unlike the other passes' pair_lanes_wrapped: through that function this file's passes gave
+ * other bits (the build's -cl-mad-enable lets the compiler contract them differently), and they are kept bit
+ * for bit. */
+#define PAIR_LANES(pi, j, period)                                           \
+  const floatV dx = nearest_image((pi).x - vloadV(0, xs.x + (j)), (period).x); \
+  const floatV dy = nearest_image((pi).y - vloadV(0, xs.y + (j)), (period).y); \
+  const floatV dz = nearest_image((pi).z - vloadV(0, xs.z + (j)), (period).z); \
   const floatV r2 = dx * dx + dy * dy + dz * dz;
-
-/* A walk's start for particle i: the support, the periodic lengths, the reorder's position blocks X, Y, Z,
- * the carriers' masses M, and i's position and cell. */
-#define WALK_START                                                          \
-  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;                  \
-  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f); \
-  global const float* X = soa;                                              \
-  global const float* Y = soa + stride;                                     \
-  global const float* Z = soa + 2 * stride;                                 \
-  global const float* M = sub + SUB_M * stride;                             \
-  const float4 pi = pos[i];                                                 \
-  const int4 cell = grid_cell(g, pi);
 
 /* A walk's compensated lanes (hi, lo) added into particle i's pair in q. */
 void add_lanes(global float2* q, const uint i, floatV hi, floatV lo) {
@@ -315,7 +306,12 @@ kernel void substance_norm(global const float4* pos, global const float* soa, gl
     sub[SUB_MOM * stride + i] = 0.0f;
     return;
   }
-  WALK_START
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
+  const Positions xs = soa_positions(soa, stride);
+  global const float* M = sub + SUB_M * stride; /* the carriers' masses */
+  const float4 pi = pos[i];
+  const int4 cell = grid_cell(g, pi);
   global const float* AS = sub + SUB_AS * stride;
   SURFACE_POINTS
   const float3 point_i = (float3)(PX[i], PY[i], PZ[i]), normal_i = (float3)(NX[i], NY[i], NZ[i]);
@@ -397,7 +393,12 @@ kernel void substance_wet(global const float4* pos, global const uchar* phase, g
     sub[SUB_F * stride + i] = 0.0f;
     return;
   }
-  WALK_START
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
+  const Positions xs = soa_positions(soa, stride);
+  global const float* M = sub + SUB_M * stride; /* the carriers' masses */
+  const float4 pi = pos[i];
+  const int4 cell = grid_cell(g, pi);
   floatV sw = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
@@ -426,7 +427,12 @@ kernel void substance_ice(global const float4* pos, global const uchar* phase, g
   const uint i = get_global_id(0);
   if (i >= P.n || phase[i] != THAW_PHASE_ICE) return;
   const uint stride = P.stride;
-  WALK_START
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
+  const Positions xs = soa_positions(soa, stride);
+  global const float* M = sub + SUB_M * stride; /* the carriers' masses */
+  const float4 pi = pos[i];
+  const int4 cell = grid_cell(g, pi);
   floatV sw = (floatV)(0.0f), sww = (floatV)(0.0f), sd = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, cell, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
@@ -537,7 +543,12 @@ kernel void substance_diffuse(global const float4* pos, global const float* soa,
 #else
   if (mi == 0.0f) return;
 #endif
-  WALK_START
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
+  const Positions xs = soa_positions(soa, stride);
+  global const float* M = sub + SUB_M * stride; /* the carriers' masses */
+  const float4 pi = pos[i];
+  const int4 cell = grid_cell(g, pi);
   global const float* A = sub + SUB_A * stride;
   const int giving = mi < 0.0f;
   const float ai = A[i], eta2 = P.eta2;

@@ -26,22 +26,6 @@ kernel void surface_inside(global const uchar* phase, global float* inside, cons
   inside[i] = (i < n && phase[i] != THAW_PHASE_AIR) ? 1.0f : 0.0f;
 }
 
-/* A neighbour pass's start: the support, particle i's position and cell, and the structure-of-arrays x, y, z. */
-#define SURFACE_START(pos, soa, stride)             \
-  const float H = P.support, H2 = H * H, inv_H = 1.0f / H; \
-  const float4 pi = (pos)[i];                       \
-  const int4 c = grid_cell(g, pi);                  \
-  global const float* X = (soa);                    \
-  global const float* Y = (soa) + (stride);         \
-  global const float* Z = (soa) + 2 * (stride);
-
-/* The minimum-image offsets x_i - x_j of the lanes j.. and r^2 (periodic axes wrap). */
-#define SURFACE_LANES(pi, j)                                            \
-  const floatV ox = THAW_WRAP((pi).x - vloadV(0, X + (j)), P.period_x); \
-  const floatV oy = THAW_WRAP((pi).y - vloadV(0, Y + (j)), P.period_y); \
-  const floatV oz = THAW_WRAP((pi).z - vloadV(0, Z + (j)), P.period_z); \
-  const floatV r2 = ox * ox + oy * oy + oz * oz;
-
 /* One pass over the neighbours: the centre of mass m_i (eq. 3) and phi (eq. 2), the colour gradient
  * grad c_i = sum_j v_j grad W_ij, the covariance C_i (eq. 8) and the neighbour count; then the delta:
  *   orthmann2013: eq. 6's half-sided tent of phi, delta_max = 1/d where the neighbourhood is singular;
@@ -72,28 +56,31 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
 #endif
     return;
   }
-  SURFACE_START(pos, soa, stride)
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 pi = pos[i];
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
   const float v = P.volume, d = P.radius;
   floatV sw = (floatV)(0.0f), count = (floatV)(0.0f);
   floatV sx = (floatV)(0.0f), sy = (floatV)(0.0f), sz = (floatV)(0.0f);
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      SURFACE_LANES(pi, j)
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-      const floatV q = sqrt(r2) * inv_H;
-      const floatV on = select((floatV)(0.0f), vloadV(0, inside + j), in);
+      const Pair o = pair_lanes_wrapped(xs, pi, period, j, je, H2);
+      const floatV q = sqrt(o.r2) * inv_H;
+      const floatV on = select((floatV)(0.0f), vloadV(0, inside + j), o.in);
       const floatV w = on * w_shape(q);
       const floatV gr = on * grad_shape(q); /* grad_i W_ij = sigma / H^2 grad_shape(q) (x_i - x_j) */
       sw += w;
       count += on;
       /* x_j - x_i = -(ox, oy, oz) */
-      sx -= w * ox;
-      sy -= w * oy;
-      sz -= w * oz;
-      gx += gr * ox;
-      gy += gr * oy;
-      gz += gr * oz;
+      sx -= w * o.dx;
+      sy -= w * o.dy;
+      sz -= w * o.dz;
+      gx += gr * o.dx;
+      gy += gr * o.dy;
+      gz += gr * o.dz;
     }
   }
   const float inv = 1.0f / lanes_sum(sw);
@@ -113,11 +100,10 @@ kernel void surface_delta(global const float4* pos, global const uchar* phase, g
            cyz = (floatV)(0.0f), czz = (floatV)(0.0f);
     FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
       for (uint j = jb; j < je; j += THAW_VW) {
-        SURFACE_LANES(pi, j)
-        const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-        const floatV w = select((floatV)(0.0f), vloadV(0, inside + j), in) * w_shape(sqrt(r2) * inv_H);
+        const Pair o = pair_lanes_wrapped(xs, pi, period, j, je, H2);
+        const floatV w = select((floatV)(0.0f), vloadV(0, inside + j), o.in) * w_shape(sqrt(o.r2) * inv_H);
         /* x_j - m_i, with the same minimum image as x_j - x_i */
-        const floatV ex = -ox - m.x, ey = -oy - m.y, ez = -oz - m.z;
+        const floatV ex = -o.dx - m.x, ey = -o.dy - m.y, ez = -o.dz - m.z;
         cxx += w * ex * ex;
         cxy += w * ex * ey;
         cxz += w * ex * ez;
@@ -186,13 +172,16 @@ kernel void surface_area(global const float4* pos, global const uchar* phase, gl
   if (i >= P.n) return;
   const uchar ph = phase[i];
   if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) return;
-  SURFACE_START(pos, soa, stride)
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 pi = pos[i];
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
   floatV sw = (floatV)(0.0f), sdw = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      SURFACE_LANES(pi, j)
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-      const floatV w = select((floatV)(0.0f), vloadV(0, inside + j), in) * w_shape(sqrt(r2) * inv_H);
+      const Pair o = pair_lanes_wrapped(xs, pi, period, j, je, H2);
+      const floatV w = select((floatV)(0.0f), vloadV(0, inside + j), o.in) * w_shape(sqrt(o.r2) * inv_H);
       sw += w;
       sdw += w * vloadV(0, delta_lanes + j);
     }
@@ -222,13 +211,17 @@ kernel void surface_layer(global const float4* pos, global const uchar* phase, g
   if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) return;
   const float3 n = normal[i].xyz;
   if (!(dot(n, n) > 0.0f) || !(area[i] > THAW_LAYER_MIN_AREA * P.spacing * P.spacing)) return;
-  SURFACE_START(pos, soa, stride)
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 pi = pos[i];
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
   int covered = 0;
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je && !covered; ++j) {
       if (!(inside[j] > 0.0f) || j == i) continue;
-      const float3 o = (float3)(THAW_WRAP(X[j] - pi.x, P.period_x), THAW_WRAP(Y[j] - pi.y, P.period_y),
-                                THAW_WRAP(Z[j] - pi.z, P.period_z));
+      const float3 o = (float3)(THAW_WRAP(xs.x[j] - pi.x, P.period_x), THAW_WRAP(xs.y[j] - pi.y, P.period_y),
+                                THAW_WRAP(xs.z[j] - pi.z, P.period_z));
       const float r2 = dot(o, o), up = dot(o, n);
       covered = r2 < H2 && up > 0.0f && up * up > 0.5f * r2;
     }
@@ -255,16 +248,19 @@ kernel void surface_project(global const float4* pos, global const uchar* phase,
   if (i >= P.n || layer[i] > 1.5f) return;
   const uchar ph = phase[i];
   if (ph != THAW_PHASE_WATER && ph != THAW_PHASE_ICE) return;
-  SURFACE_START(pos, soa, stride)
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const float4 pi = pos[i];
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
+  const float4 period = (float4)(P.period_x, P.period_y, P.period_z, 0.0f);
   global const float* LX = layer_n;
   global const float* LY = layer_n + stride;
   global const float* LZ = layer_n + 2 * stride;
   floatV nx = (floatV)(0.0f), ny = (floatV)(0.0f), nz = (floatV)(0.0f);
   FOR_EACH_HEAT_RANGE(g, cell_start, c, jb, je) {
     for (uint j = jb; j < je; j += THAW_VW) {
-      SURFACE_LANES(pi, j)
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-      const floatV w = select((floatV)(0.0f), 1.0f - sqrt(r2) * inv_H, in);
+      const Pair o = pair_lanes_wrapped(xs, pi, period, j, je, H2);
+      const floatV w = select((floatV)(0.0f), 1.0f - sqrt(o.r2) * inv_H, o.in);
       nx += w * vloadV(0, LX + j);
       ny += w * vloadV(0, LY + j);
       nz += w * vloadV(0, LZ + j);

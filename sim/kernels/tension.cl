@@ -78,35 +78,19 @@ kernel void tension_columns(global const uchar* phase, global const uchar* mater
 #endif
 }
 
-/* A neighbour pass's start: particle i's position and cell, the support and the candidates' x, y, z. */
-#define TENSION_START     \
-  const float4 pi = pos[i]; \
-  TENSION_WALK(pi)
-
-/* The same with pi already in scope: the support, pi's cell and the candidates' x, y, z. */
-#define TENSION_WALK(pi)                                    \
-  const float H = P.support, H2 = H * H, inv_H = 1.0f / H; \
-  const int4 c = grid_cell(g, pi);                          \
-  global const float* X = soa;                              \
-  global const float* Y = soa + stride;                     \
-  global const float* Z = soa + 2 * stride;
-
 /* sum_j V_j grad_shape(r / H) (x_i - x_j) over the neighbours within H, on lanes: the colour gradient
  * sum_j V_j grad W_ij less the kernel's sigma / H^2 (akinci2013's normals, brackbill1992's). */
 float3 colour_gradient_sum(const float4 pi, const int4 c, const Grid g, global const uint* cell_start,
-                           global const float* X, global const float* Y, global const float* Z,
-                           global const float* V, const float H2, const float inv_H) {
+                           const Positions xs, global const float* V, const float H2, const float inv_H) {
   floatV gx = (floatV)(0.0f), gy = (floatV)(0.0f), gz = (floatV)(0.0f);
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pr.x - vloadV(0, X + j), dy = pr.y - vloadV(0, Y + j), dz = pr.z - vloadV(0, Z + j);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2);
-      const floatV s = select((floatV)(0.0f), vloadV(0, V + j) * grad_shape(sqrt(r2) * inv_H), in);
-      gx += s * dx;
-      gy += s * dy;
-      gz += s * dz;
+      const Pair o = pair_lanes(xs, pr, j, je, H2);
+      const floatV s = select((floatV)(0.0f), vloadV(0, V + j) * grad_shape(sqrt(o.r2) * inv_H), o.in);
+      gx += s * o.dx;
+      gy += s * o.dy;
+      gz += s * o.dz;
     }
   }
   return (float3)(lanes_sum(gx), lanes_sum(gy), lanes_sum(gz));
@@ -130,9 +114,12 @@ kernel void tension_normals(global const float4* pos, global const uchar* phase,
   const uint i = get_global_id(0);
   if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
   const uint stride = P.stride;
-  TENSION_START
+  const float4 pi = pos[i];
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
   const float3 n = H * THAW_SIGMA(H) * inv_H * inv_H *
-                   colour_gradient_sum(pi, c, g, cell_start, X, Y, Z, col + COL_V * stride, H2, inv_H);
+                   colour_gradient_sum(pi, c, g, cell_start, xs, col + COL_V * stride, H2, inv_H);
   col[(COL_NX + 0) * stride + i] = n.x;
   col[(COL_NX + 1) * stride + i] = n.y;
   col[(COL_NX + 2) * stride + i] = n.z;
@@ -162,10 +149,13 @@ kernel void tension_surface(global const float4* pos, global const uchar* phase,
   const uint i = get_global_id(0);
   if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
   const uint stride = P.stride;
-  TENSION_START
+  const float4 pi = pos[i];
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
   global const float* V = col + COL_V * stride;
   const float3 grad =
-      THAW_SIGMA(H) * inv_H * inv_H * colour_gradient_sum(pi, c, g, cell_start, X, Y, Z, V, H2, inv_H);
+      THAW_SIGMA(H) * inv_H * inv_H * colour_gradient_sum(pi, c, g, cell_start, xs, V, H2, inv_H);
   const float g_len = length(grad);
   if (!(g_len > 0.0f)) return;
   const float3 n = -grad / g_len;
@@ -178,7 +168,7 @@ kernel void tension_surface(global const float4* pos, global const uchar* phase,
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je && !covered; ++j) {
       if (!(V[j] > 0.0f)) continue;
-      const float3 o = (float3)(X[j] - pr.x, Y[j] - pr.y, Z[j] - pr.z);
+      const float3 o = (float3)(xs.x[j] - pr.x, xs.y[j] - pr.y, xs.z[j] - pr.z);
       const float r2 = dot(o, o);
       const float up = dot(o, n);
       covered = r2 < H2 && up > 0.0f && up * up > 0.5f * r2;
@@ -194,12 +184,11 @@ kernel void tension_surface(global const float4* pos, global const uchar* phase,
 /* Outer-layer particle j's surface point less particle i's, each half a spacing out along its normal:
  * s_j - s_i = (x_j - x_i) + (dx / 2)(n_j - n_i), with pr as particle i's position that row sees (minimum
  * image). */
-float3 surface_offset(const float4 pr, const uint j, global const float* X, global const float* Y,
-                      global const float* Z, global const float* col, const uint stride, const float3 ni,
-                      const float half_dx) {
+float3 surface_offset(const float4 pr, const uint j, const Positions xs, global const float* col,
+                      const uint stride, const float3 ni, const float half_dx) {
   const float3 nj = (float3)(col[(COL_NX + 0) * stride + j], col[(COL_NX + 1) * stride + j],
                              col[(COL_NX + 2) * stride + j]);
-  return (float3)(X[j] - pr.x, Y[j] - pr.y, Z[j] - pr.z) + half_dx * (nj - ni);
+  return (float3)(xs.x[j] - pr.x, xs.y[j] - pr.y, xs.z[j] - pr.z) + half_dx * (nj - ni);
 }
 
 /* kappa_i: the mean curvature at s_i of the quadric h = a u^2 + b u v + c v^2 + d u + e v + f fitted by
@@ -215,7 +204,10 @@ kernel void tension_curvature(global const float4* pos, global const uchar* phas
   const uint stride = P.stride;
   global const float* BAND = col + COL_BAND * stride;
   if (!(BAND[i] > 0.0f)) return;
-  TENSION_START
+  const float4 pi = pos[i];
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
   const float3 ni = (float3)(col[(COL_NX + 0) * stride + i], col[(COL_NX + 1) * stride + i],
                              col[(COL_NX + 2) * stride + i]);
   const float half_dx = 0.5f * P.spacing;
@@ -238,7 +230,7 @@ kernel void tension_curvature(global const float4* pos, global const uchar* phas
     for (uint j = jb; j < je; ++j) {
       if (!(BAND[j] > 0.0f)) continue;
       if (NX[j] * ni.x + NY[j] * ni.y + NZ[j] * ni.z <= 0.5f) continue;
-      const float3 o = surface_offset(pr, j, X, Y, Z, col, stride, ni, half_dx);
+      const float3 o = surface_offset(pr, j, xs, col, stride, ni, half_dx);
       if (dot(o, o) >= rf2) continue;
       const float u = dot(o, e1) * inv_dx, v = dot(o, e2) * inv_dx, h = dot(o, ni) * inv_dx;
       const float w = fmax(1.0f - (u * u + v * v) / rf2_dx, 0.0f) + 1e-3f;
@@ -312,7 +304,10 @@ kernel void tension_smooth(global const float4* pos, global const uchar* phase, 
   global const float* OK = col + COL_OK * stride;
   global const float* A = col + COL_A * stride;
   if (!(OK[i] > 0.0f)) return;
-  TENSION_START
+  const float4 pi = pos[i];
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
   const int from = into_k2 ? COL_K : COL_K2, to = into_k2 ? COL_K2 : COL_K;
   global const float* K = col + from * stride;
   global const float* NX = col + (COL_NX + 0) * stride;
@@ -326,7 +321,7 @@ kernel void tension_smooth(global const float4* pos, global const uchar* phase, 
     for (uint j = jb; j < je; ++j) {
       if (!(OK[j] > 0.0f)) continue;
       if (NX[j] * ni.x + NY[j] * ni.y + NZ[j] * ni.z <= 0.5f) continue;
-      const float3 o = (float3)(X[j] - pr.x, Y[j] - pr.y, Z[j] - pr.z);
+      const float3 o = (float3)(xs.x[j] - pr.x, xs.y[j] - pr.y, xs.z[j] - pr.z);
       const float r2 = dot(o, o);
       if (r2 >= rs2) continue;
       const float w = A[j] * (1.0f - r2 / rs2);
@@ -352,7 +347,10 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
   const uint i = get_global_id(0);
   if (i >= P.n || phase[i] != THAW_PHASE_WATER) return;
   const uint stride = P.stride;
-  TENSION_START
+  const float4 pi = pos[i];
+  const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+  const int4 c = grid_cell(g, pi);
+  const Positions xs = soa_positions(soa, stride);
   global const float* W = col + COL_W * stride;
   global const float* B = col + COL_B * stride;
   const float rho_i = col[COL_R * stride + i];
@@ -378,10 +376,9 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
   FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
     const float4 pr = THAW_ROW_POS(g, c, pi);
     for (uint j = jb; j < je; j += THAW_VW) {
-      const floatV dx = pr.x - vloadV(0, X + j), dy = pr.y - vloadV(0, Y + j), dz = pr.z - vloadV(0, Z + j);
-      const floatV r2 = dx * dx + dy * dy + dz * dz;
       /* i itself (r = 0) takes no part; lanes past the row may hold anything: masked after the products. */
-      const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2) & (r2 > 1e-12f * H2);
+      const Pair o = pair_lanes(xs, pr, j, je, H2);
+      const intV in = o.in & (o.r2 > 1e-12f * H2);
 #if defined(THAW_TENSION_ADHESION) || defined(THAW_TENSION_IWASAKI2010)
       const floatV b = vloadV(0, B + j);
 #endif
@@ -393,11 +390,11 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
       const floatV pair_s = (floatV)(1.0f);
 #endif
 #ifdef THAW_TENSION_IWASAKI2010
-      const floatV s = -(P.cohesion * vloadV(0, W + j) * pair_s + b) * inv_m / fmax(r2, 1e-30f);
-      const floatV fx = s * dx, fy = s * dy, fz = s * dz;
+      const floatV s = -(P.cohesion * vloadV(0, W + j) * pair_s + b) * inv_m / fmax(o.r2, 1e-30f);
+      const floatV fx = s * o.dx, fy = s * o.dy, fz = s * o.dz;
 #else
       /* approximate reciprocals: the shapes need no more, and divisions cost a third of the pass (forces.cl) */
-      const floatV inv_r = native_rsqrt(fmax(r2, 1e-30f)), q = r2 * inv_r * inv_H;
+      const floatV inv_r = native_rsqrt(fmax(o.r2, 1e-30f)), q = o.r2 * inv_r * inv_H;
       const floatV nx = vloadV(0, NX + j), ny = vloadV(0, NY + j), nz = vloadV(0, NZ + j);
       const floatV w = vloadV(0, W + j);
       const floatV k = two_rho0 * native_recip(rho_i + vloadV(0, R + j));
@@ -409,7 +406,8 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
 #endif
       const floatV s = -cohesion * k * w * pair_s * akinci_cohesion_shape(q) * inv_r + sa;
       const floatV kc = select((floatV)(0.0f), -curv * k * pair_s, w > 0.0f);
-      const floatV fx = s * dx + kc * (nix - nx), fy = s * dy + kc * (niy - ny), fz = s * dz + kc * (niz - nz);
+      const floatV fx = s * o.dx + kc * (nix - nx), fy = s * o.dy + kc * (niy - ny),
+                   fz = s * o.dz + kc * (niz - nz);
 #endif
       ax += select((floatV)(0.0f), fx, in);
       ay += select((floatV)(0.0f), fy, in);
@@ -444,7 +442,9 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
    * eq. 30). The gradient is fitted by weighted least squares to sigma_j - sigma_i over the outer layer's
    * particles in the support, on the tangent plane of n_i, so a linear sigma gives its slope exactly. */
   if (area_i > 0.0f) {
-    TENSION_WALK(pi)
+    const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+    const int4 c = grid_cell(g, pi);
+    const Positions xs = soa_positions(soa, stride);
     global const float* A = col + COL_A * stride;
     global const float* S = col + COL_S * stride;
     const float3 e = fabs(n.x) < 0.6f ? (float3)(1.0f, 0.0f, 0.0f) : (float3)(0.0f, 1.0f, 0.0f);
@@ -454,7 +454,9 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
     FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
       const float4 pr = THAW_ROW_POS(g, c, pi);
       for (uint j = jb; j < je; j += THAW_VW) {
-        const floatV dx = vloadV(0, X + j) - pr.x, dy = vloadV(0, Y + j) - pr.y, dz = vloadV(0, Z + j) - pr.z;
+        /* x_j - x_i: the fit's offsets point from i to its neighbours */
+        const floatV dx = vloadV(0, xs.x + j) - pr.x, dy = vloadV(0, xs.y + j) - pr.y,
+                     dz = vloadV(0, xs.z + j) - pr.z;
         const floatV r2 = dx * dx + dy * dy + dz * dz;
         const floatV area_j = vloadV(0, A + j);
         const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2) & (r2 > 1e-12f * H2) & (area_j > 0.0f);
@@ -480,21 +482,22 @@ kernel void tension_forces(global const float4* pos, global const uchar* phase, 
 #endif
 #ifdef THAW_TENSION_ADHESION
   {
-    TENSION_WALK(pi)
+    const float H = P.support, H2 = H * H, inv_H = 1.0f / H;
+    const int4 c = grid_cell(g, pi);
+    const Positions xs = soa_positions(soa, stride);
     global const float* B = col + COL_B * stride;
     const float adhesion = 0.007f / (H * H * H);
     floatV ax = (floatV)(0.0f), ay = (floatV)(0.0f), az = (floatV)(0.0f);
     FOR_EACH_NEIGHBOUR_ROW(g, cell_start, c, jb, je) {
       const float4 pr = THAW_ROW_POS(g, c, pi);
       for (uint j = jb; j < je; j += THAW_VW) {
-        const floatV dx = pr.x - vloadV(0, X + j), dy = pr.y - vloadV(0, Y + j), dz = pr.z - vloadV(0, Z + j);
-        const floatV r2 = dx * dx + dy * dy + dz * dz;
-        const intV in = (THAW_LANE_IDS < (int)(je - j)) & (r2 < H2) & (r2 > 1e-12f * H2);
-        const floatV inv_r = native_rsqrt(fmax(r2, 1e-30f)), q = r2 * inv_r * inv_H;
+        const Pair o = pair_lanes(xs, pr, j, je, H2);
+        const intV in = o.in & (o.r2 > 1e-12f * H2);
+        const floatV inv_r = native_rsqrt(fmax(o.r2, 1e-30f)), q = o.r2 * inv_r * inv_H;
         const floatV s = -adhesion * vloadV(0, B + j) * THAW_AKINCI_ADHESION(q) * inv_r;
-        ax += select((floatV)(0.0f), s * dx, in);
-        ay += select((floatV)(0.0f), s * dy, in);
-        az += select((floatV)(0.0f), s * dz, in);
+        ax += select((floatV)(0.0f), s * o.dx, in);
+        ay += select((floatV)(0.0f), s * o.dy, in);
+        az += select((floatV)(0.0f), s * o.dz, in);
       }
     }
     a += (float3)(lanes_sum(ax), lanes_sum(ay), lanes_sum(az));

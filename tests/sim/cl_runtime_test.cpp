@@ -65,22 +65,20 @@ TEST_F(KernelBuild, EveryEmbeddedStageBuilds) {
   for (const char* stage : {"grid.cl", "boundary.cl", "density.cl", "forces.cl", "integrate.cl",
                             "step_limits.cl", "heat.cl", "dfsph.cl"})
     EXPECT_NO_THROW(
-        cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "thermal_law.h", "dryer_model.h",
-                    "heat_params.h", "fluid_params.h", "dfsph_columns.h", "wrapped_walk.h", stage},
+        cl().build(neighbour_program({"thermal_law.h", "dryer_model.h", "heat_params.h", "fluid_params.h",
+                                      "dfsph_columns.h", "wrapped_walk.h", stage}),
                    "-DKERNEL_W=cubic_spline_w -DKERNEL_GRAD=cubic_spline_grad_factor -DTHAW_EOS_TAIT"))
         << stage;
   // The surface stage, both models (sim/surface_stage.cpp).
   for (const char* model : {"-DTHAW_AREA_BRACKBILL1992", "-DTHAW_AREA_ORTHMANN2013"})
-    EXPECT_NO_THROW(cl().build(
-        {"sph_kernel.h", "grid_common.h", "sph_lanes.h", "wrapped_walk.h", "surface_params.h", "surface.cl"},
-        std::string("-DTHAW_REACH=1 -DTHAW_VW=8 ") + model))
+    EXPECT_NO_THROW(cl().build(neighbour_program({"wrapped_walk.h", "surface_params.h", "surface.cl"}),
+                               std::string("-DTHAW_REACH=1 -DTHAW_VW=8 ") + model))
         << model;
   // The tension stage, its three models (sim/tension_stage.cpp).
   for (const char* model : {"-DTHAW_TENSION_AKINCI2013", "-DTHAW_TENSION_IWASAKI2010",
                             "-DTHAW_TENSION_BRACKBILL1992 -DTHAW_FIT_REACH=2 -DTHAW_TENSION_ADHESION"})
-    EXPECT_NO_THROW(
-        cl().build({"sph_kernel.h", "grid_common.h", "sph_lanes.h", "tension_params.h", "tension.cl"},
-                   std::string("-DTHAW_REACH=1 -DTHAW_VW=8 ") + model))
+    EXPECT_NO_THROW(cl().build(neighbour_program({"tension_params.h", "tension.cl"}),
+                               std::string("-DTHAW_REACH=1 -DTHAW_VW=8 ") + model))
         << model;
 }
 
