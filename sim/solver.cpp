@@ -109,9 +109,8 @@ std::pair<Eigen::Vector3f, Eigen::Vector3f> particle_bounds(const Scene& scene, 
 // Boundary particles sampled by sample_scene() carry no mass yet: their Psi = rho0 V_b comes from the
 // solver's rest density. Walls here sit on the fluid lattice and fill the kernel support, so the lattice
 // cell dx^3 is their exact volume; Akinci's 1 / sum_k W_bk suits single-layer or irregular samplings but
-// overestimates the fluid-facing layer of a lattice wall (by 18 % at H = 2 dx, which raised the
-// wall-adjacent density by 2.6 %: measured with configs/hydrostatic-tank.json). Returns whether any
-// boundary mass was missing.
+// overestimates the fluid-facing layer of a lattice wall (docs/ARCHITECTURE.md, Numerics). Returns whether
+// any boundary mass was missing.
 bool give_boundaries_lattice_mass(HostParticles& p, const Scene& scene, float rest_density) {
   bool missing = false;
   const float lattice_psi = static_cast<float>(rest_density * std::pow(scene.spacing, 3));

@@ -67,8 +67,7 @@ SolverConstants derive_constants(const Scene& scene) {
   }
   // Tension's pair forces pull bulk water in with a cohesive pressure p_c that the equation of state holds:
   // the stiffness must dwarf it as it does the flow's dynamic pressure, so v_ref is at least sqrt(2 p_c /
-  // rho0) (measured: iwasaki2010 drops of R = 10 spacings blew up in 65 steps at c = 10 sqrt(2 sigma / (rho
-  // R))).
+  // rho0) (without it drops blew up: docs/TENSION.md).
   if (scene.tension.enabled())
     v_ref =
         std::max(v_ref, std::sqrt(2.0 * tension_coefficients(scene, k).cohesive_pressure / k.rest_density));

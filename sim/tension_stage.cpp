@@ -99,7 +99,8 @@ TensionStage::TensionStage(const StageContext& c)
     opts += " -DTHAW_TENSION_ADHESION";
   lowered_ = substances_lower_tension(c.scene);
   if (lowered_) opts += " -DTHAW_TENSION_LOWERED";
-  const auto program = c.cl.build(neighbour_program({"tension_params.h", "tension.cl"}), opts);
+  const std::string model_file = std::string("tension_") + name(model_) + ".cl";
+  const auto program = c.cl.build(neighbour_program({"tension_params.h", "tension.cl", model_file}), opts);
   k_columns_ = cl::Kernel(program, "tension_columns");
   if (model_ == TensionModel::Akinci2013) k_normals_ = cl::Kernel(program, "tension_normals");
   if (csf) {

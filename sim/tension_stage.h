@@ -1,7 +1,7 @@
 #pragma once
 // The tension stage: interfacial tension of water (tension.model), accelerations added to the forces pass's
 // before the time step is chosen, so both WCSPH and DFSPH (its predicted velocities) take them. Three models,
-// selectable by name (sim/kernels/tension.cl has the equations):
+// selectable by name (sim/kernels/tension_<model>.cl has each one's equations, tension.cl what they share):
 //   akinci2013: Akinci, Akinci & Teschner 2013, cohesion (eqs. 1, 3) and curvature (eqs. 2, 4) between
 //     water particles, K_ij-corrected (eq. 5);
 //   iwasaki2010: Iwasaki et al. 2010 eq. 4, an attraction k (x_j - x_i) / r^2 to water and ice neighbours
