@@ -87,18 +87,20 @@ bool pass_timer(Pass p, Stage& timer) {
 const char* pass_name(Pass p) { return info(p).name; }
 const char* pass_stage(Pass p) { return info(p).stage; }
 
+BuiltStages every_stage(bool dfsph) {
+  return {.flow = true,
+          .dfsph = dfsph,
+          .tension = true,
+          .rigid = true,
+          .heat = true,
+          .photons = true,
+          .surface = true,
+          .substances = true,
+          .emitters = true};
+}
+
 std::string step_table() {
-  BuiltStages all{.flow = true,
-                  .tension = true,
-                  .rigid = true,
-                  .heat = true,
-                  .photons = true,
-                  .surface = true,
-                  .substances = true,
-                  .emitters = true};
-  const std::vector<Pass> wcsph = step_plan(all);
-  all.dfsph = true;
-  const std::vector<Pass> dfsph = step_plan(all);
+  const std::vector<Pass> wcsph = step_plan(every_stage(false)), dfsph = step_plan(every_stage(true));
   std::string out = "| pass | what it does | stage | timer | WCSPH | DFSPH |\n|---|---|---|---|:-:|:-:|\n";
   auto row = [&](Pass p, bool w, bool d) {
     Stage t;

@@ -48,6 +48,8 @@ enum class Pass {
 
 // The passes of one step, in order.
 std::vector<Pass> step_plan(const BuiltStages& built);
+// Every stage built, under DFSPH or WCSPH (the doc's table, tests).
+BuiltStages every_stage(bool dfsph);
 
 // The timer a pass adds to; Advance has none (false).
 bool pass_timer(Pass p, Stage& timer);

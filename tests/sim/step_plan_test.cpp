@@ -31,17 +31,7 @@ bool has(const std::vector<Pass>& plan, Pass p) {
 }
 
 TEST(StepPlan, TheTwoSolversDifferOnlyInTheirSolvesAndWhereIceTakesItsForces) {
-  BuiltStages all{.flow = true,
-                  .tension = true,
-                  .rigid = true,
-                  .heat = true,
-                  .photons = true,
-                  .surface = true,
-                  .substances = true,
-                  .emitters = true};
-  const std::vector<Pass> wcsph = step_plan(all);
-  all.dfsph = true;
-  const std::vector<Pass> dfsph = step_plan(all);
+  const std::vector<Pass> wcsph = step_plan(every_stage(false)), dfsph = step_plan(every_stage(true));
   EXPECT_FALSE(has(wcsph, Pass::DivergenceSolve));
   EXPECT_FALSE(has(wcsph, Pass::DensitySolve));
   EXPECT_EQ(without(dfsph, {Pass::DivergenceSolve, Pass::DensitySolve, Pass::IceForces}),
@@ -69,16 +59,7 @@ TEST(StepPlan, AStageNotBuiltHasNoPass) {
 }
 
 TEST(StepPlan, EveryTimedPassAddsToItsStagesTimer) {
-  BuiltStages all{.flow = true,
-                  .tension = true,
-                  .rigid = true,
-                  .heat = true,
-                  .photons = true,
-                  .surface = true,
-                  .substances = true,
-                  .emitters = true};
-  all.dfsph = true;
-  for (const Pass p : step_plan(all)) {
+  for (const Pass p : step_plan(every_stage(true))) {
     Stage t = Stage::Count;
     if (p == Pass::Advance) {
       EXPECT_FALSE(pass_timer(p, t));
