@@ -1,28 +1,19 @@
-/* Accelerations of fluid particles: symmetric pressure force (Monaghan 1992), viscosity (Monaghan
- * 2005's form, covering both the physical and the artificial part), gravity.
- * The viscous pair term divides by rho_i rho_j / rho0 (as Morris et al. 1997 do), not by rho_j alone:
- * the pair's forces m_i a_ij and m_j a_ji are then equal and opposite where the two densities differ
- * (at a free surface, between water and meltwater), so viscosity moves momentum, never makes it. With
- * 1/rho_j alone a zero-gravity ball of water lost 0.3 % of an ice block's momentum in 300 steps
- * (RigidIceTest.IceAndWaterKeepTheirTotalMomentumWithViscosity). rigid.cl's reaction on ice matches.
- * Solid particles (walls, static solids; not ice) also push a fluid particle closer than rep_r0 (0.95
- * spacings) straight away, a spring and dashpot as stiff as the ice contacts (rigid.cl) that pushes,
- * never pulls:
- * m_i m_b K max((r0 - r) / r - D (v_ij . x_ij) / r^2, 0) x_ij, K = c^2 / (dx^2 rho0 dx^3), D = dx / c
- * (half the critical damping of two particles of mass rho0 dx^3). Water in bulk keeps a spacing from
- * walls and does not feel it, but a lone drop has too little density for pressure: it sank half a
- * spacing into a wall, onto the domain's face, where the clamp caught it every step
- * (SolverTest.LoneDropsRestOnAWallWithoutTheClamp).
- * Boundary particles (mass Psi_b, Akinci et al. 2012) enter with their own summation density and
- * pressure (see density.cl), so the pressure force is exactly the gradient of the total internal
- * energy and the system stays conservative: a damped state settles. Akinci's one-sided term
- * -Psi_b p_i/rho_i^2 grad W is conservative too but carries only half the load, so a water column
- * sinks into the floor; mirroring (p_b = p_i) or hydrostatic extrapolation (Adami et al. 2012) is not
- * an energy gradient and pumped energy into particles at a tank's vertical edges. Both measured with
- * configs/hydrostatic-tank.json and `thaw validate hydrostatic`.
- * Candidates are read THAW_VW at a time (SIMD lanes: grid_common.h) from the reorder's
- * structure-of-arrays copy (x, y, z, m, vx, vy, vz) and the per-particle factors the density pass
- * wrote (derived: k_j m_j / rho_j, m_j p_j / rho_j^2, and m_j for solid particles). */
+/* Accelerations of fluid particles: the symmetric pressure force (Monaghan 1992), viscosity (Monaghan 2005's
+ * form, the physical and the artificial part), gravity, and the walls' push.
+ * - Viscosity's pair term divides by rho_i rho_j / rho0 (Morris et al. 1997), so a pair's forces are equal
+ *   and opposite where the densities differ and viscosity moves momentum without making it (rigid.cl's
+ *   reaction on ice matches; docs/ARCHITECTURE.md, Numerics).
+ * - Solid particles (walls, static solids; not ice) push a fluid particle closer than rep_r0 (0.95 spacings)
+ *   away, a spring and dashpot as stiff as the ice contacts (rigid.cl) that never pulls:
+ *   m_i m_b K max((r0 - r) / r - D (v_ij . x_ij) / r^2, 0) x_ij, K = c^2 / (dx^2 rho0 dx^3), D = dx / c,
+ *   so a lone drop, too thin for pressure, rests on a wall instead of sinking into it.
+ * - Boundary particles (mass Psi_b, Akinci et al. 2012) enter with their own summation density and pressure
+ *   (density.cl): the pressure force is then the gradient of the total internal energy, and a damped state
+ *   settles. Akinci's one-sided -Psi_b p_i / rho_i^2 grad W carries half the load; mirroring and Adami et
+ *   al. 2012's extrapolation are not energy gradients (docs/ARCHITECTURE.md, Numerics).
+ * Candidates are read THAW_VW at a time (SIMD lanes: grid_common.h) from the reorder's structure-of-arrays
+ * copy (x, y, z, m, vx, vy, vz) and the per-particle factors the density pass wrote (k_j m_j / rho_j,
+ * m_j p_j / rho_j^2, and m_j for solid particles). */
 
 /* The boundary push's factor of x_ij (without m_b K): zero beyond r0, never negative. */
 floatV repulsion(const floatV r, const floatV vd, const float r0, const float d) {
