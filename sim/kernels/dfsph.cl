@@ -60,10 +60,8 @@
 
 /* Relaxed Jacobi (solver.pressure_relaxation, as IISPH's omega = 0.5, Ihmsen et al. 2014): each sweep
  * applies omega of the kappa that would zero a particle's own error. Unrelaxed (omega = 1), neighbours
- * that all correct the same compression at once overshoot; the kicks left the water under-dense at its
- * surface: in the floating case the level at release stood 9 mm above WCSPH's and the prism sank to a
- * draft of 1.53 of its height. With 0.5: the level within 1 mm, draft 0.899 against 0.917, and the
- * dam break takes 2.18 density sweeps a step instead of 2.01. */
+ * that all correct the same compression at once overshoot and leave the water under-dense at its surface
+ * (docs/ARCHITECTURE.md, Numerics, has the floating case's figures). */
 #ifndef THAW_OMEGA
 #define THAW_OMEGA 0.5f
 #endif
@@ -229,15 +227,12 @@ kernel void dfsph_error(global const float4* pos, global const float* soa, globa
 /* A boundary particle's KR from the fluid around it (Adami et al. 2012, eq 27, the wall's acceleration
  * left out): p_b = Σ_f m_f W_bf (p_f + ρ_f g·(x_b - x_f)) / Σ_f m_f W_bf, p_f = KR_f ρ_f², KR_b = p_b / ρ_b²
  * with ρ_b the density the fluid's equation of state gives p_b (Adami's eq 28), which for an
- * incompressible fluid is its rest density ρ0, not the boundary particle's summed density: that runs
- * below ρ0 where the boundary's own neighbourhood is thin (a body's edges and waterline), and with it
- * the water pushed a prism held at Archimedes' draft with 1.022 of its weight (1.008 with ρ0, density
- * tolerance 0.01 %), floating it at 0.894 of its height below the water's mass level (0.902 with ρ0).
- * The gravity term is a pressure, not an increment: it enters once a step, with the density solve's warm
- * start (`hydrostatic` 1), where the solve meets gravity; later sweeps extrapolate the increments alone.
- * It gives the boundary layer the pressure at its own depth rather than that of the fluid a spacing
- * below it; measured, it changes little: the floating prism's draft 0.897 of its height with it, 0.895
- * without; the hydrostatic case 0.27 % and 8.5e-4 sqrt(gH) with it, 0.37 % and 6.7e-4 without. */
+ * incompressible fluid is its rest density ρ0, not the boundary particle's summed density, which runs
+ * below ρ0 where the boundary's own neighbourhood is thin (a body's edges and waterline) and overloads
+ * bodies there. The gravity term is a pressure, not an increment: it enters once a step, with the density
+ * solve's warm start (`hydrostatic` 1), where the solve meets gravity; later sweeps extrapolate the
+ * increments alone. It gives the boundary layer the pressure at its own depth rather than that of the
+ * fluid a spacing below it. (docs/ARCHITECTURE.md, Numerics, has what each choice measured.) */
 kernel void dfsph_extrapolate(global const float4* pos, global const float* soa, global const float* density,
                               global const uchar* phase, global float* col, global const uint* cell_start,
                               const Grid g, const float H, const float4 gravity, const int hydrostatic,
