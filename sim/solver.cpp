@@ -550,20 +550,12 @@ void Solver::trace_photons(double dt) {
 
 NeighbourView Solver::neighbours() const { return grid_->view(); }
 
-void Solver::update_surface() {
-  // Without flow the particles never move: the first pass's areas serve the whole run. With flow they are
-  // updated every heat.area_interval steps (counted from step 0, so a resumed run updates when the straight
-  // one did).
+// Without flow the particles never move: the first pass's areas serve the whole run. With flow they are
+// updated every heat.area_interval steps (counted from step 0, so a resumed run updates when the straight one
+// did).
+bool Solver::surface_due() const {
   const auto interval = static_cast<std::uint64_t>(scene_.heat.area_interval);
-  if (surface_ && (!surface_done_ || (scene_.solver.flow && steps_ % interval == 0))) {
-    timed(Stage::Surface, [&] { surface_->run(neighbours()); });
-    surface_done_ = true;
-  }
-}
-
-void Solver::heat_stages(double dt) {
-  timed(Stage::Photons, [&] { trace_photons(dt); });
-  timed(Stage::Heat, [&] { compute_heat(dt); });
+  return !surface_done_ || (scene_.solver.flow && steps_ % interval == 0);
 }
 
 void Solver::compute_heat(double dt) {
@@ -635,19 +627,23 @@ void Solver::run_pass(Pass p, double& dt) {
       break;
     case Pass::IceForces:
       timed(timer, [&] {
-        if (!dfsph_) return rigid_->compute_forces(buffers());
-        // After DFSPH's solves: their pressure impulses, and the forces pass's viscosity from the velocities
-        // that pass saw (rigid.cl).
         const ParticleBuffers b = buffers();
-        rigid_->compute_forces({b.position, forces_velocity_, b.state, b.phase, b.material, b.id,
-                                b.cell_start, b.grid, b.n, b.ids});
+        if (!dfsph_) {
+          rigid_->compute_forces(b);
+        } else {
+          // After DFSPH's solves: their pressure impulses, and the forces pass's viscosity from the
+          // velocities that pass saw (rigid.cl).
+          rigid_->compute_forces({b.position, forces_velocity_, b.state, b.phase, b.material, b.id,
+                                  b.cell_start, b.grid, b.n, b.ids});
+        }
       });
       break;
     case Pass::TimeStep:
       timed(timer, [&] { dt = choose_time_step(); });
       break;
     case Pass::Surface:
-      update_surface();
+      if (surface_due()) timed(timer, [&] { surface_->run(neighbours()); });
+      surface_done_ = true;
       break;
     case Pass::SubstanceState:
       timed(timer, [&] { substances_->prepare(neighbours()); });
@@ -812,10 +808,7 @@ std::vector<std::string> Solver::stages() const {
                               (scene_.air.buoyancy == Buoyancy::IdealGas ? ", eq 7's ideal-gas air)" : ")")
                         : "pressure (dfsph)");
     } else if (p == Pass::Photons) {
-      if (heat_->tracing_photons())
-        out.push_back(stage);
-      else if (!scene_.lamps.empty())
-        out.push_back("photons (when a lamp is on)");
+      out.push_back(heat_->tracing_photons() ? stage : "photons (when a lamp is on)");
     } else if (p == Pass::Surface) {
       out.push_back(stage + " (" + name(surface_->model()) + ")");
     } else if (p == Pass::Heat) {

@@ -115,8 +115,6 @@ class Solver {
   double choose_time_step();
   void trace_photons(double dt);  // lamps: photons absorbed this step, as energy per particle
   void compute_heat(double dt);   // conduction, sources, enthalpy update, phase change, budget
-  void update_surface();          // the surface stage's areas, when they are due (heat.area_interval)
-  void heat_stages(double dt);    // photons, the surface's areas where heat reads them, then heat, each timed
   void integrate(double dt);
   // Rigid ice only (no-ops otherwise): label the ice into bodies now, and the ice-force pass; the force
   // on each particle [N] as that pass left it (zero for all but ice of free bodies).
@@ -205,6 +203,7 @@ class Solver {
   std::unique_ptr<DfsphStage> dfsph_;
   std::vector<Pass> plan_;  // the step's passes (build() makes it from the stages built)
   void run_pass(Pass p, double& dt);
+  bool surface_due() const;  // the surface stage's areas are due this step (heat.area_interval)
   // DFSPH with free ice: the velocities the forces pass saw, kept for rigid ice's viscous reaction (the
   // solves change the water's velocities before the ice takes it).
   cl::Buffer forces_velocity_;

@@ -45,6 +45,13 @@ constexpr std::array<PassInfo, 18> kPasses = {{
     {Pass::Emit, "emit", "emit", Stage::Emit, "taps, air dryers and room air add particles, growing the run"},
 }};
 
+constexpr bool in_enum_order() {
+  for (std::size_t k = 0; k < kPasses.size(); ++k)
+    if (static_cast<std::size_t>(kPasses[k].pass) != k) return false;
+  return true;
+}
+static_assert(in_enum_order(), "kPasses is indexed by Pass: one row per pass, in the enum's order");
+
 const PassInfo& info(Pass p) { return kPasses[static_cast<std::size_t>(p)]; }
 
 }  // namespace

@@ -106,7 +106,7 @@ CaseResult run(ClRuntime& cl, const Json& prm, int res) {
     }
     keep_only(st.particles, keep);
     // The areas the state carries are the old surface's: held particles keep a state's areas for the whole
-    // run (Solver::update_surface), so the ice the drained water uncovered would never take the air's heat.
+    // run (Solver::surface_due), so the ice the drained water uncovered would never take the air's heat.
     // Without them the next solver finds the new surface.
     std::erase_if(st.particles.columns,
                   [](const HostColumn& c) { return c.spec.name.rfind("surface_", 0) == 0; });
